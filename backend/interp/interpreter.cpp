@@ -1,0 +1,187 @@
+#include "backend/interp/interpreter.hpp"
+
+#include "ir/semantics.hpp"
+#include "ir/series_tail.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace frac::interp {
+
+using ir::Instr;
+using ir::Interval;
+using ir::Op;
+using ir::Tape;
+using ir::TapeSeries;
+
+namespace {
+
+class Interpreter final : public ir::Evaluator {
+public:
+    Interpreter(Tape tape, const ir::EvalOptions& options)
+        : tape_(std::move(tape)), options_(options), boxes_(tape_.num_slots), points_(tape_.num_slots) {
+        if (options_.max_terms < 1 || options_.max_terms > ir::max_terms_limit)
+            throw std::invalid_argument("max_terms out of range");
+        for (const ir::TapeConst& c : tape_.constants) {
+            boxes_[c.slot] = c.value;
+            points_[c.slot] = c.point;
+        }
+    }
+
+    int dimension() const override { return tape_.inputs; }
+    std::string engine() const override { return "interp"; }
+    std::unique_ptr<ir::Evaluator> clone() const override { return std::make_unique<Interpreter>(tape_, options_); }
+
+    double eval_point(const double* coords) override {
+        ++stats.calls;
+        load(points_, coords);
+        run_points(0);
+        return points_[tape_.result];
+    }
+
+    Interval eval_box(const Interval* box) override {
+        ++stats.calls;
+        num::UpwardRounding up;
+        load(boxes_, box);
+        run_boxes(0);
+        return boxes_[tape_.result];
+    }
+
+    void eval_boxes(const Interval* boxes, std::size_t n, Interval* out) override {
+        num::UpwardRounding up; // once per batch
+        const auto d = static_cast<std::size_t>(tape_.inputs);
+        for (std::size_t i = 0; i < n; ++i) {
+            ++stats.calls;
+            load(boxes_, boxes + i * d);
+            run_boxes(0);
+            out[i] = boxes_[tape_.result];
+        }
+    }
+
+private:
+    template <class V>
+    void load(std::vector<V>& regs, const V* inputs) {
+        for (std::size_t k = 0; k < tape_.input_slots.size(); ++k)
+            if (tape_.input_slots[k] != ir::no_slot) regs[tape_.input_slots[k]] = inputs[k];
+    }
+
+    void run_boxes(std::uint32_t block) {
+        Interval args[3];
+        for (const Instr& ins : tape_.blocks[block]) {
+            if (ir::is_series(ins.op)) {
+                boxes_[ins.out] = series_box(tape_.series[ins.series]);
+                continue;
+            }
+            for (int i = 0; i < ir::arity(ins.op); ++i) args[i] = boxes_[ins.in[static_cast<std::size_t>(i)]];
+            boxes_[ins.out] = ir::apply_interval(ins.op, args, ins.imm);
+        }
+    }
+
+    void run_points(std::uint32_t block) {
+        double args[3];
+        for (const Instr& ins : tape_.blocks[block]) {
+            if (ir::is_series(ins.op)) {
+                points_[ins.out] = series_point(tape_.series[ins.series]);
+                continue;
+            }
+            for (int i = 0; i < ir::arity(ins.op); ++i) args[i] = points_[ins.in[static_cast<std::size_t>(i)]];
+            points_[ins.out] = ir::apply_point(ins.op, args, ins.imm);
+        }
+    }
+
+    std::int64_t last_index(const TapeSeries& s) const {
+        return s.data.end == ir::infinite_end ? s.data.start + options_.max_terms - 1 : s.data.end;
+    }
+
+    // Sums terms while they resolve something the tail bound does not, then encloses the rest.
+    Interval series_box(const TapeSeries& s) {
+        const bool infinite = s.data.end == ir::infinite_end;
+        const bool has_b = s.tail_b != ir::no_slot;
+        const Interval a = infinite ? boxes_[s.tail_a] : Interval(0.0);
+        const Interval b = has_b ? boxes_[s.tail_b] : Interval(0.0);
+        const std::int64_t last = last_index(s);
+        Interval gamma_i = infinite ? num::powi(s.data.gamma, s.data.start) : Interval(1.0);
+        Interval acc;
+        std::int64_t i = s.data.start;
+        bool resolved = !infinite;
+        for (;; ++i) {
+            boxes_[s.index_slot] = Interval(static_cast<double>(i));
+            run_boxes(s.block);
+            const Interval term = boxes_[s.body_slot];
+            acc = i == s.data.start ? term : ir::series_combine(s.kind, acc, term);
+            ++stats.series_terms;
+            if (i == last) break;
+            if (infinite) {
+                // Stop when this term told no more than its static bound: the box is too wide for
+                // later terms to resolve anything.
+                const Interval bound = ir::series_term_bound(a, b, has_b, gamma_i, i);
+                if (num::width(term) >= num::width(bound)) {
+                    resolved = true;
+                    break;
+                }
+                const Interval tail = ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i);
+                if (num::width(tail) <= 0x1p-52 * num::magnitude(acc) || num::width(tail) == 0) {
+                    resolved = true;
+                    break;
+                }
+                gamma_i = num::mul(gamma_i, s.data.gamma);
+            }
+        }
+        if (!infinite) return acc;
+        if (!resolved) ++stats.series_capped;
+        return ir::series_combine(s.kind, acc, ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i));
+    }
+
+    double series_point(const TapeSeries& s) {
+        const bool infinite = s.data.end == ir::infinite_end;
+        const bool has_b = s.tail_b != ir::no_slot;
+        const double a = infinite ? std::fabs(points_[s.tail_a]) : 0.0;
+        const double b = has_b ? std::fabs(points_[s.tail_b]) : 0.0;
+        const double gamma = s.data.gamma.hi;
+        const std::int64_t last = last_index(s);
+        double gamma_next = infinite ? std::pow(gamma, static_cast<double>(s.data.start + 1)) : 0.0;
+        double acc = 0.0;
+        std::int64_t i = s.data.start;
+        bool resolved = !infinite;
+        for (;; ++i) {
+            points_[s.index_slot] = static_cast<double>(i);
+            run_points(s.block);
+            const double term = points_[s.body_slot];
+            acc = i == s.data.start ? term : ir::series_combine_point(s.kind, acc, term);
+            ++stats.series_terms;
+            if (i == last) break;
+            if (infinite) {
+                // Estimate of the tail's size: stop once it is below half an ulp of the sum.
+                const double n1 = static_cast<double>(i + 1);
+                const double tail = (a + b * n1) * gamma_next * (n1 + 1.0) / ((1.0 - gamma) * (1.0 - gamma));
+                if (tail <= 0x1p-54 * std::fabs(acc) || tail == 0.0) {
+                    resolved = true;
+                    break;
+                }
+                gamma_next *= gamma;
+            }
+        }
+        if (!infinite) return acc;
+        if (!resolved) ++stats.series_capped;
+        Interval tail;
+        {
+            num::UpwardRounding up;
+            tail = ir::series_tail(s.kind, Interval(points_[s.tail_a]),
+                                   has_b ? Interval(points_[s.tail_b]) : Interval(0.0), has_b, s.data.gamma, i);
+        }
+        return ir::series_combine_point(s.kind, acc, num::midpoint(tail));
+    }
+
+    Tape tape_;
+    ir::EvalOptions options_;
+    std::vector<Interval> boxes_;
+    std::vector<double> points_;
+};
+
+} // namespace
+
+std::unique_ptr<ir::Evaluator> make_interpreter(ir::Tape tape, const ir::EvalOptions& options) {
+    return std::make_unique<Interpreter>(std::move(tape), options);
+}
+
+} // namespace frac::interp

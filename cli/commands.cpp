@@ -1,0 +1,147 @@
+// frac check, eval, render, dimension.
+#include "cli/commands.hpp"
+
+#include "runtime/dimension.hpp"
+#include "runtime/picture.hpp"
+#include "runtime/rss.hpp"
+
+#include <fmt/format.h>
+#include <iostream>
+#include <unistd.h>
+
+namespace frac::cli {
+
+int run_check(const std::string& file, const std::string& emit, const std::string& shape) {
+    const auto stop = emit == "ast" ? front::StopAfter::parse : front::StopAfter::elaborate;
+    auto c = compile_or_report(file, stop);
+    if (!c) return front::exit_compile_error;
+    if (emit == "ast") {
+        std::cout << front::print_ast(c->program);
+        return 0;
+    }
+    const front::Module& m = c->module;
+    std::vector<const front::ShapeInfo*> shapes;
+    if (!shape.empty())
+        shapes.push_back(&find_shape(*c, shape));
+    else
+        for (const auto& s : m.shapes) shapes.push_back(&s);
+    for (const front::ShapeInfo* s : shapes) {
+        if (emit == "ir") {
+            std::cout << fmt::format("shape {} ({} coordinates):\n{}", s->name, s->dimension, ir::print_graph(m.graph, {s->root}));
+        } else if (emit == "tape") {
+            std::cout << fmt::format("shape {}:\n{}", s->name, ir::print_tape(ir::build_tape(m.graph, s->root, s->dimension)));
+        }
+    }
+    if (emit.empty())
+        std::cout << fmt::format("{}: ok ({} shapes, {} tests)\n", file, m.shapes.size(), m.tests.size());
+    return 0;
+}
+
+int run_eval(const std::string& file, const std::string& shape, const std::string& at, const std::string& box,
+             const EngineOptions& engine) {
+    auto c = compile_or_report(file);
+    if (!c) return front::exit_compile_error;
+    const front::ShapeInfo& s = find_shape(*c, shape);
+    auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
+    if (!at.empty()) {
+        std::vector<ir::Interval> enclosure;
+        const std::vector<double> p = parse_point(at, s.dimension, &enclosure);
+        const double value = eval->eval_point(p.data());
+        const ir::Interval proven = eval->eval_box(enclosure.data());
+        std::cout << fmt::format("{} = {}\nenclosure {}\n", s.name, value, format_interval(proven));
+    }
+    if (!box.empty()) {
+        const auto b = parse_box(box, s.dimension);
+        std::cout << fmt::format("enclosure over the box {}\n", format_interval(eval->eval_box(b.data())));
+    }
+    if (at.empty() && box.empty()) throw RunError("give --at x,y or --box x0:x1,y0:y1");
+    return 0;
+}
+
+namespace {
+
+rt::RssProgress terminal_progress() {
+    if (!isatty(STDERR_FILENO)) return {};
+    return [](int level, std::uint64_t evaluated) {
+        std::cerr << fmt::format("\rlevel {:2}: {} boxes evaluated", level, evaluated) << std::flush;
+    };
+}
+
+rt::RssResult cover(const front::ShapeInfo& s, const std::vector<ir::Interval>& box, int depth, int split,
+                    bool keep_cells, ir::Evaluator& eval) {
+    rt::RssOptions ro;
+    ro.depth = depth;
+    ro.split = split;
+    ro.keep_cells = keep_cells;
+    ro.progress = terminal_progress();
+    try {
+        rt::RssResult r = rt::subdivide(eval, box, ro);
+        if (ro.progress) std::cerr << "\n";
+        return r;
+    } catch (const std::invalid_argument& e) {
+        throw RunError(e.what());
+    }
+}
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+    return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+} // namespace
+
+int run_render(const std::string& file, const RenderOptions& o, const EngineOptions& engine) {
+    if (o.output.empty() && o.ascii.empty()) throw RunError("give -o out.png|out.svg or --ascii COLSxROWS");
+    rt::PictureKind kind = rt::PictureKind::both;
+    if (o.kind == "process") kind = rt::PictureKind::process;
+    else if (o.kind == "cover") kind = rt::PictureKind::cover;
+    else if (o.kind != "both") throw RunError(fmt::format("unknown picture kind '{}' (process, cover, both)", o.kind));
+    if (!o.output.empty() && !ends_with(o.output, ".png") && !ends_with(o.output, ".svg"))
+        throw RunError(fmt::format("cannot tell the picture format of '{}': use .png or .svg", o.output));
+    auto c = compile_or_report(file);
+    if (!c) return front::exit_compile_error;
+    const front::ShapeInfo& s = pick_shape(*c, o.shape);
+    if (s.dimension != 2) throw RunError(fmt::format("shape '{}' is {}D; pictures are of 2D shapes", s.name, s.dimension));
+    auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
+    const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
+    const rt::RssResult r = cover(s, box, o.depth, o.split, true, *eval);
+    std::cerr << fmt::format("{}: depth {}, {} boxes evaluated: {} inside, {} outside, {} boundary; {:.3f} s\n",
+                             s.name, o.depth, r.evaluated, r.inside, r.outside, r.boundary, r.seconds);
+    if (!o.ascii.empty()) {
+        int cols = 0, rows = 0;
+        if (std::sscanf(o.ascii.c_str(), "%dx%d", &cols, &rows) != 2 || cols < 1 || rows < 1 || cols > 1000 || rows > 1000)
+            throw RunError(fmt::format("--ascii needs COLSxROWS such as 64x32, not '{}'", o.ascii));
+        std::cout << rt::ascii_picture(r, cols, rows);
+    }
+    if (!o.output.empty()) {
+        if (o.size < 16 || o.size > 8192) throw RunError("--size must be between 16 and 8192 pixels");
+        try {
+            if (ends_with(o.output, ".png")) rt::write_png(r, o.output, kind, o.size);
+            else rt::write_svg(r, o.output, kind);
+        } catch (const std::runtime_error& e) {
+            throw RunError(e.what());
+        }
+        std::cerr << fmt::format("wrote {}\n", o.output);
+    }
+    return 0;
+}
+
+int run_dimension(const std::string& file, const std::string& shape, int from, int to, int split,
+                  const EngineOptions& engine) {
+    auto c = compile_or_report(file);
+    if (!c) return front::exit_compile_error;
+    const front::ShapeInfo& s = pick_shape(*c, shape);
+    auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
+    const rt::RssResult r = cover(s, s.box, to, split, false, *eval);
+    rt::DimensionEstimate d;
+    try {
+        d = rt::box_counting(r, from, to);
+    } catch (const std::invalid_argument& e) {
+        throw RunError(e.what());
+    }
+    for (const auto& [level, count] : d.counts) std::cout << fmt::format("level {:2}: {} boxes\n", level, count);
+    std::cout << fmt::format("box-counting dimension of {}: {:.4f} (r^2 = {:.5f}, levels {}..{}, split {})\n", s.name,
+                             d.dimension, d.r_squared, from, to, split);
+    return 0;
+}
+
+} // namespace frac::cli

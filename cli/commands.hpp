@@ -1,0 +1,25 @@
+// The frac subcommands; each returns the process exit code.
+#pragma once
+
+#include "cli/session.hpp"
+
+#include <string>
+#include <vector>
+
+namespace frac::cli {
+
+struct RenderOptions {
+    std::string shape, box, output, kind = "both", ascii;
+    int depth = 8, split = 2, size = 512;
+};
+
+int run_check(const std::string& file, const std::string& emit, const std::string& shape);
+int run_eval(const std::string& file, const std::string& shape, const std::string& at, const std::string& box,
+             const EngineOptions& engine);
+int run_render(const std::string& file, const RenderOptions& options, const EngineOptions& engine);
+int run_dimension(const std::string& file, const std::string& shape, int from, int to, int split,
+                  const EngineOptions& engine);
+// Runs the print statements (when `prints`) and the tests of each file; prints "N passed, N failed".
+int run_tests(const std::vector<std::string>& files, bool prints, const EngineOptions& engine);
+
+} // namespace frac::cli

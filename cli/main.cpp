@@ -1,0 +1,88 @@
+// frac: the command-line tool. Thin: it wires the frontend, the engines and the runtime together.
+#include "cli/commands.hpp"
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <iostream>
+
+int main(int argc, char** argv) {
+    using namespace frac;
+    CLI::App app{"frac: fractal geometric modeling with guaranteed interval evaluation"};
+    app.require_subcommand(1);
+    cli::EngineOptions engine;
+    auto add_engine = [&](CLI::App* sub) {
+        sub->add_option("--engine", engine.engine, "evaluation engine")->check(CLI::IsMember({"interp"}));
+        sub->add_option("--max-terms", engine.eval.max_terms, "most terms of an infinite series before its tail bound")
+            ->check(CLI::Range(1, ir::max_terms_limit));
+    };
+
+    std::string file, shape, emit, at, box;
+    auto* check = app.add_subcommand("check", "parse, check and lower a model; --emit shows a stage");
+    check->add_option("file", file, "model file")->required();
+    check->add_option("--emit", emit, "print the ast, the ir graph or the tape")->check(CLI::IsMember({"ast", "ir", "tape"}));
+    check->add_option("--shape", shape, "only this shape");
+
+    auto* eval = app.add_subcommand("eval", "evaluate a shape at a point or over a box");
+    eval->add_option("file", file, "model file")->required();
+    eval->add_option("shape", shape, "shape name")->required();
+    eval->add_option("--at", at, "point x,y[,z]");
+    eval->add_option("--box", box, "box x0:x1,y0:y1[,z0:z1]");
+    add_engine(eval);
+
+    cli::RenderOptions render_options;
+    auto* render = app.add_subcommand("render", "cover a 2D shape by recursive subdivision and draw it");
+    render->add_option("file", file, "model file")->required();
+    render->add_option("shape", render_options.shape, "shape name (default: the last shape of the file)");
+    render->add_option("--depth", render_options.depth, "subdivision depth")->check(CLI::Range(0, 64));
+    render->add_option("--split", render_options.split, "parts per axis and level")->check(CLI::Range(2, 4));
+    render->add_option("--box", render_options.box, "view box x0:x1,y0:y1 (default: the shape's)");
+    render->add_option("-o,--output", render_options.output, "picture file, .png or .svg");
+    render->add_option("--kind", render_options.kind, "process, cover or both (side by side)");
+    render->add_option("--size", render_options.size, "pixels per panel (PNG)");
+    render->add_option("--ascii", render_options.ascii, "also print a COLSxROWS character picture");
+    add_engine(render);
+
+    int from = 4, to = 9, split = 2;
+    auto* dimension = app.add_subcommand("dimension", "box-counting dimension of a shape's boundary from its cover");
+    dimension->add_option("file", file, "model file")->required();
+    dimension->add_option("shape", shape, "shape name (default: the last shape of the file)");
+    dimension->add_option("--from", from, "first level of the fit")->check(CLI::Range(0, 64));
+    dimension->add_option("--to", to, "last level (the subdivision depth)")->check(CLI::Range(1, 64));
+    dimension->add_option("--split", split, "parts per axis and level")->check(CLI::Range(2, 4));
+    add_engine(dimension);
+
+    std::vector<std::string> files;
+    auto* test = app.add_subcommand("test", "run the test blocks of model files");
+    test->add_option("files", files, "model files")->required();
+    add_engine(test);
+    auto* run = app.add_subcommand("run", "run a model's print statements, then its tests");
+    run->add_option("file", file, "model file")->required();
+    add_engine(run);
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+    try {
+        if (*check) return cli::run_check(file, emit, shape);
+        if (*eval) return cli::run_eval(file, shape, at, box, engine);
+        if (*render) return cli::run_render(file, render_options, engine);
+        if (*dimension) return cli::run_dimension(file, shape, from, to, split, engine);
+        if (*test) return cli::run_tests(files, false, engine);
+        if (*run) return cli::run_tests({file}, true, engine);
+    } catch (const cli::RunError& e) {
+        std::cerr << "frac: error: " << e.what() << "\n";
+        return front::exit_runtime_error;
+    } catch (const front::InternalError& e) {
+        std::cerr << "frac: internal error (a bug in frac, please report it): " << e.what() << "\n";
+        return front::exit_internal_error;
+    } catch (const std::bad_alloc&) {
+        std::cerr << "frac: error: out of memory\n";
+        return front::exit_runtime_error;
+    } catch (const std::exception& e) {
+        std::cerr << "frac: internal error (a bug in frac, please report it): " << e.what() << "\n";
+        return front::exit_internal_error;
+    }
+    return 0;
+}

@@ -1,0 +1,46 @@
+// What every command does first: compile a model, report its diagnostics, and make evaluators.
+#pragma once
+
+#include "frontend/driver.hpp"
+#include "ir/evaluator.hpp"
+#include "ir/tape.hpp"
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace frac::cli {
+
+struct EngineOptions {
+    std::string engine = "interp";
+    ir::EvalOptions eval;
+};
+
+// A user-facing run-time failure (bad option value, unknown shape, I/O): message and exit code 1.
+struct RunError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// Compiles `path`; on errors prints the diagnostics to stderr and returns null.
+std::unique_ptr<front::Compilation> compile_or_report(const std::string& path,
+                                                      front::StopAfter stop = front::StopAfter::elaborate);
+
+const front::ShapeInfo& find_shape(const front::Compilation& c, const std::string& name);
+// The shape named, or the model's only/first shape when `name` is empty.
+const front::ShapeInfo& pick_shape(const front::Compilation& c, const std::string& name);
+
+std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId root, int inputs,
+                                              const EngineOptions& options);
+
+// Parses "x0:x1,y0:y1[,z0:z1]" into an outward box; "x,y" into a point (and its outward enclosure).
+std::vector<ir::Interval> parse_box(const std::string& text, int dimension);
+std::vector<double> parse_point(const std::string& text, int dimension, std::vector<ir::Interval>* enclosure);
+
+std::string format_interval(ir::Interval v);
+
+// Runs the model's queries (enclose, dimension) that `tape` reads, caching answers in `answers`.
+std::vector<ir::Interval> answer_queries(const front::Module& m, const ir::Tape& tape, const EngineOptions& options,
+                                         std::vector<std::optional<ir::Interval>>& answers);
+
+} // namespace frac::cli

@@ -1,0 +1,13 @@
+# Debian 12 packages, installed by scripts/install-deps.sh.
+find_package(fmt REQUIRED)
+find_package(Catch2 2 REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(PNG REQUIRED)
+find_package(PkgConfig REQUIRED)
+
+# LLVM's libc: correctly rounded exp/log/sin/cos/tan that honour the current rounding mode.
+find_library(LLVMLIBC_ARCHIVE llvmlibc PATHS /usr/lib/llvm-19/lib NO_DEFAULT_PATH REQUIRED)
+# MPFR/MPFI: high-precision oracle for the soundness tests only.
+find_library(MPFR_LIBRARY mpfr REQUIRED)
+find_library(MPFI_LIBRARY mpfi REQUIRED)
+find_library(GMP_LIBRARY gmp REQUIRED)

@@ -1,0 +1,11 @@
+# Writes a C++ file holding each stdlib/*.frac as a string, looked up by its stem ("fractals").
+separate_arguments(file_list UNIX_COMMAND "${FILES}")
+set(body "#include <map>\n#include <string>\nnamespace frac::front {\nconst std::map<std::string, std::string>& embedded_stdlib() {\n  static const std::map<std::string, std::string> files = {\n")
+foreach(f IN LISTS file_list)
+  get_filename_component(stem "${f}" NAME_WE)
+  file(READ "${f}" text)
+  string(APPEND body "    {\"${stem}\", R\"frac_stdlib(${text})frac_stdlib\"},\n")
+endforeach()
+string(APPEND body "  };\n  return files;\n}\n}\n")
+file(WRITE "${OUT}.tmp" "${body}")
+file(COPY_FILE "${OUT}.tmp" "${OUT}" ONLY_IF_DIFFERENT)

@@ -1,0 +1,92 @@
+// S-expression form of the syntax tree (frac check --emit=ast).
+#include "frontend/ast.hpp"
+
+#include <fmt/format.h>
+
+namespace frac::front {
+
+namespace {
+
+const char* op_text(Tok op) {
+    switch (op) {
+    case Tok::plus: return "+";
+    case Tok::minus: return "-";
+    case Tok::star: return "*";
+    case Tok::slash: return "/";
+    case Tok::caret: return "^";
+    case Tok::amp: return "&";
+    case Tok::bar: return "|";
+    case Tok::tilde: return "~";
+    case Tok::times: return "×";
+    case Tok::lt: return "<";
+    case Tok::le: return "<=";
+    case Tok::gt: return ">";
+    case Tok::ge: return ">=";
+    case Tok::eq: return "==";
+    case Tok::ne: return "!=";
+    case Tok::kw_and: return "and";
+    case Tok::kw_or: return "or";
+    case Tok::kw_not: return "not";
+    default: return token_name(op);
+    }
+}
+
+} // namespace
+
+std::string print_expr(const Expr& e) {
+    auto kids = [&](std::size_t from = 0) {
+        std::string s;
+        for (std::size_t i = from; i < e.kids.size(); ++i) s += " " + (e.kids[i] ? print_expr(*e.kids[i]) : "inf");
+        return s;
+    };
+    switch (e.kind) {
+    case ExprKind::number:
+    case ExprKind::name: return e.text;
+    case ExprKind::call: {
+        std::string s = "(call " + e.text;
+        for (const Arg& a : e.args) s += " " + (a.name.empty() ? "" : a.name + ": ") + print_expr(*a.value);
+        return s + ")";
+    }
+    case ExprKind::unary:
+    case ExprKind::binary: return fmt::format("({}{})", op_text(e.op), kids());
+    case ExprKind::if_: return fmt::format("(if{})", kids());
+    case ExprKind::let: {
+        std::string s = "(let (";
+        for (std::size_t i = 0; i < e.bindings.size(); ++i)
+            s += (i ? " " : "") + fmt::format("({} {})", e.bindings[i].name, print_expr(*e.bindings[i].value));
+        return s + ")" + kids() + ")";
+    }
+    case ExprKind::tuple: return fmt::format("(point{})", kids());
+    case ExprKind::field: return fmt::format("(. {}{})", e.text, kids());
+    case ExprKind::interval: return fmt::format("(interval{})", kids());
+    case ExprKind::series: return fmt::format("({} {}{})", e.text, e.var, kids());
+    }
+    return "?";
+}
+
+std::string print_ast(const Program& p) {
+    std::string out;
+    for (const Item& it : p.items) {
+        std::string params;
+        for (std::size_t i = 0; i < it.params.size(); ++i) params += (i ? " " : "") + it.params[i].name;
+        switch (it.kind) {
+        case ItemKind::import: out += fmt::format("(import \"{}\")\n", it.name); break;
+        case ItemKind::fn: out += fmt::format("(fn {} ({}) {})\n", it.name, params, print_expr(*it.body)); break;
+        case ItemKind::const_: out += fmt::format("(const {} {})\n", it.name, print_expr(*it.body)); break;
+        case ItemKind::shape:
+            out += fmt::format("(shape {} ({}){} {})\n", it.name, params,
+                               it.over ? " (over " + print_expr(*it.over) + ")" : "", print_expr(*it.body));
+            break;
+        case ItemKind::test:
+            out += fmt::format("(test \"{}\"", it.name);
+            for (const Expect& e : it.expects)
+                out += fmt::format("\n  (expect {}{})", print_expr(*e.expr), e.within ? " (within " + print_expr(*e.within) + ")" : "");
+            out += ")\n";
+            break;
+        case ItemKind::print: out += fmt::format("(print {})\n", print_expr(*it.body)); break;
+        }
+    }
+    return out;
+}
+
+} // namespace frac::front

@@ -1,0 +1,31 @@
+// The builtin functions and constants, shared by name resolution and elaboration.
+#pragma once
+
+#include "ir/graph.hpp"
+
+#include <optional>
+#include <string>
+
+namespace frac::front {
+
+enum class BuiltinKind {
+    unary,     // an IR op of one argument
+    binary,    // an IR op of two arguments
+    variadic,  // min/max of two or more arguments
+    mod,       // mod(x, m)
+    pow,       // pow(x, y) = x^y
+    enclose,   // enclose(shape, box): a proven enclosure (tests and print only)
+    dimension, // dimension(shape, from: a, to: b [, split: s]) (tests and print only)
+};
+
+struct Builtin {
+    const char* name;
+    BuiltinKind kind;
+    int min_args, max_args;
+    ir::Op op;
+};
+
+const Builtin* find_builtin(const std::string& name);
+bool is_builtin_constant(const std::string& name); // pi, e
+
+} // namespace frac::front

@@ -1,0 +1,59 @@
+#include "frontend/diagnostics.hpp"
+
+#include <algorithm>
+#include <fmt/format.h>
+
+namespace frac::front {
+
+SourceManager::SourceManager() { files_.push_back({"<unknown>", ""}); }
+
+std::uint32_t SourceManager::add(std::string name, std::string text) {
+    files_.push_back({std::move(name), std::move(text)});
+    return static_cast<std::uint32_t>(files_.size() - 1);
+}
+
+std::string SourceManager::line_text(Location loc) const {
+    if (loc.file == 0 || loc.file >= files_.size() || loc.line == 0) return {};
+    const std::string& t = files_[loc.file].text;
+    std::size_t pos = 0;
+    for (std::uint32_t l = 1; l < loc.line && pos != std::string::npos; ++l) {
+        pos = t.find('\n', pos);
+        if (pos != std::string::npos) ++pos;
+    }
+    if (pos == std::string::npos || pos > t.size()) return {};
+    const std::size_t end = t.find('\n', pos);
+    return t.substr(pos, end == std::string::npos ? std::string::npos : end - pos);
+}
+
+void Diagnostics::error(Location loc, std::string message) {
+    ++errors_;
+    if (errors_ <= max_errors) list_.push_back({Severity::error, loc, std::move(message)});
+}
+
+void Diagnostics::note(Location loc, std::string message) { list_.push_back({Severity::note, loc, std::move(message)}); }
+
+std::string Diagnostics::render(const SourceManager& sm) const {
+    std::vector<Diagnostic> sorted = list_;
+    std::stable_sort(sorted.begin(), sorted.end(), [](const Diagnostic& a, const Diagnostic& b) {
+        return std::tie(a.loc.file, a.loc.line, a.loc.column) < std::tie(b.loc.file, b.loc.line, b.loc.column);
+    });
+    std::string out;
+    for (const Diagnostic& d : sorted) {
+        const char* kind = d.severity == Severity::error ? "error" : d.severity == Severity::warning ? "warning" : "note";
+        if (d.loc.file != 0)
+            out += fmt::format("{}:{}:{}: {}: {}\n", sm.name(d.loc.file), d.loc.line, d.loc.column, kind, d.message);
+        else
+            out += fmt::format("{}: {}\n", kind, d.message);
+        const std::string line = sm.line_text(d.loc);
+        if (!line.empty()) {
+            out += "  " + line + "\n";
+            std::string caret = "  ";
+            for (std::uint32_t c = 1; c < d.loc.column && c - 1 < line.size(); ++c) caret += line[c - 1] == '\t' ? '\t' : ' ';
+            out += caret + "^\n";
+        }
+    }
+    if (errors_ > max_errors) out += fmt::format("{} more errors not shown\n", errors_ - max_errors);
+    return out;
+}
+
+} // namespace frac::front

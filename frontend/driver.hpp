@@ -1,0 +1,35 @@
+// The frontend pipeline, in order: read (with imports) -> lex -> parse -> resolve names -> elaborate
+// (types, lowering, series bounds) -> verify the graph.
+#pragma once
+
+#include "frontend/ast.hpp"
+#include "frontend/elaborate.hpp"
+#include "frontend/module.hpp"
+
+#include <map>
+#include <memory>
+#include <string>
+
+namespace frac::front {
+
+struct Compilation {
+    SourceManager sources;
+    Diagnostics diags;
+    Program program; // the items of every file, imported files first
+    Module module;
+    bool ok() const { return !diags.has_errors(); }
+};
+
+enum class StopAfter { parse, resolve, elaborate };
+
+// Compiles a model file. Never throws for a bad model: problems are in `diags`.
+std::unique_ptr<Compilation> compile_file(const std::string& path, const Limits& limits = {},
+                                          StopAfter stop = StopAfter::elaborate);
+// Same, from text (name is used in diagnostics; imports resolve relative to the working directory).
+std::unique_ptr<Compilation> compile_source(const std::string& name, const std::string& text,
+                                            const Limits& limits = {}, StopAfter stop = StopAfter::elaborate);
+
+// The standard library files embedded in the binary, by name ("fractals").
+const std::map<std::string, std::string>& embedded_stdlib();
+
+} // namespace frac::front

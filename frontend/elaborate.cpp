@@ -1,0 +1,594 @@
+#include "frontend/elaborate.hpp"
+
+#include "frontend/builtins.hpp"
+#include "frontend/series_bounds.hpp"
+
+#include <cmath>
+#include <fmt/format.h>
+#include <optional>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace frac::front {
+
+using ir::Op;
+
+namespace {
+
+const char* kind_name(ValueKind k) {
+    switch (k) {
+    case ValueKind::scalar: return "a number";
+    case ValueKind::boolean: return "a condition";
+    case ValueKind::point: return "a point";
+    case ValueKind::interval: return "an interval";
+    case ValueKind::box: return "a box";
+    }
+    return "a value";
+}
+
+// A typed value during elaboration.
+struct Value {
+    ValueKind kind = ValueKind::scalar;
+    std::vector<NodeId> nodes;
+    std::vector<Interval> box;
+    const Item* shape = nullptr; // a shape used as a value (enclose, dimension)
+
+    static Value scalar(NodeId n) { return {ValueKind::scalar, {n}, {}, nullptr}; }
+    static Value boolean(NodeId n) { return {ValueKind::boolean, {n}, {}, nullptr}; }
+};
+
+// Where an expression is elaborated: what it may use.
+enum class Context { shape, constant, test };
+
+class Elaborator {
+public:
+    Elaborator(const Program& p, const SourceManager& sm, const Limits& limits, Module& m, Diagnostics& d)
+        : p_(p), sm_(sm), limits_(limits), m_(m), g_(m.graph), d_(d) {}
+
+    void run() {
+        for (const Item& it : p_.items) {
+            if (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape)
+                globals_[it.name] = &it;
+        }
+        // Shapes first, in source order, so that tests can refer to any of them.
+        for (const Item& it : p_.items)
+            if (it.kind == ItemKind::shape) guarded([&] { shape_info(it); });
+        for (const Item& it : p_.items) {
+            switch (it.kind) {
+            case ItemKind::const_: guarded([&] { constant(it); }); break;
+            case ItemKind::test: test(it); break;
+            case ItemKind::print: guarded([&] { print(it); }); break;
+            case ItemKind::import:
+            case ItemKind::fn:
+            case ItemKind::shape: break;
+            }
+        }
+    }
+
+private:
+    template <class F>
+    void guarded(F&& f) {
+        try {
+            f();
+        } catch (const CompileError& e) {
+            d_.error(e.loc, e.what());
+        }
+    }
+
+    [[noreturn]] static void fail(Location loc, const std::string& message) { throw CompileError(loc, message); }
+
+    // ---- items ----
+    std::size_t shape_info(const Item& it) {
+        if (auto done = shape_index_.find(&it); done != shape_index_.end()) {
+            if (done->second == in_progress) fail(it.loc, fmt::format("shape '{}' is defined in terms of itself", it.name));
+            return done->second;
+        }
+        shape_index_[&it] = in_progress;
+        ShapeInfo info;
+        info.name = it.name;
+        info.loc = it.loc;
+        if (it.over) {
+            const Value box = closed(*it.over, Context::constant);
+            if (box.kind != ValueKind::box)
+                fail(it.over->loc, fmt::format("'over' needs a box such as [0, 1] × [0, 1], found {}", kind_name(box.kind)));
+            info.box = box.box;
+        }
+        if (it.has_params) {
+            info.dimension = static_cast<int>(it.params.size());
+        } else {
+            info.dimension = info.box.empty() ? 2 : static_cast<int>(info.box.size());
+        }
+        if (info.dimension < 2 || info.dimension > 3)
+            fail(it.loc, fmt::format("a shape has 2 or 3 coordinates, '{}' has {}", it.name, info.dimension));
+        if (info.box.empty()) info.box.assign(static_cast<std::size_t>(info.dimension), Interval{0.0, 1.0});
+        if (static_cast<int>(info.box.size()) != info.dimension)
+            fail(it.over->loc, fmt::format("shape '{}' has {} coordinates but its box has {} axes", it.name,
+                                           info.dimension, info.box.size()));
+        std::vector<Value> coords;
+        for (int k = 0; k < info.dimension; ++k) coords.push_back(Value::scalar(g_.var(k)));
+        info.root = shape_body(it, coords, it.loc);
+        m_.shapes.push_back(info);
+        shape_index_[&it] = m_.shapes.size() - 1;
+        return m_.shapes.size() - 1;
+    }
+
+    // The shape's function applied to the given coordinates.
+    NodeId shape_body(const Item& it, const std::vector<Value>& coords, Location call_loc) {
+        const int dim = it.has_params ? static_cast<int>(it.params.size()) : static_cast<int>(coords.size());
+        Scope scope;
+        static const char* implicit[] = {"x", "y", "z"};
+        for (int k = 0; k < dim; ++k) scope.emplace_back(it.has_params ? it.params[static_cast<std::size_t>(k)].name : implicit[k], coords[static_cast<std::size_t>(k)]);
+        const Value v = inline_body(it, std::move(scope), call_loc, Context::shape);
+        if (v.kind != ValueKind::scalar)
+            fail(it.body->loc, fmt::format("a shape's function must be a number (negative inside), found {}", kind_name(v.kind)));
+        return v.nodes[0];
+    }
+
+    void constant(const Item& it) {
+        if (!failed_consts_.count(&it)) const_value(it, it.loc); // a failure was reported where it happened
+    }
+
+    Value const_value(const Item& it, Location use) {
+        if (failed_consts_.count(&it)) fail(use, fmt::format("constant '{}' has errors", it.name));
+        if (auto c = consts_.find(&it); c != consts_.end()) {
+            if (!c->second) fail(use, fmt::format("constant '{}' is defined in terms of itself", it.name));
+            return *c->second;
+        }
+        consts_[&it] = std::nullopt;
+        try {
+            const Value v = closed(*it.body, Context::constant);
+            consts_[&it] = v;
+            return v;
+        } catch (const CompileError&) {
+            consts_.erase(&it);
+            failed_consts_.insert(&it);
+            throw;
+        }
+    }
+
+    void test(const Item& it) {
+        TestInfo t;
+        t.name = it.name;
+        t.loc = it.loc;
+        for (const Expect& e : it.expects) {
+            guarded([&] {
+                Expectation x;
+                x.loc = e.loc;
+                x.source = sm_.line_text(e.loc);
+                if (e.within) {
+                    const Expr& cmp = *e.expr;
+                    if (cmp.kind != ExprKind::binary || cmp.op != Tok::eq)
+                        fail(e.within->loc, "'within' needs an equality: expect a == b within tolerance");
+                    const NodeId a = scalar(closed(*cmp.kids[0], Context::test), cmp.kids[0]->loc);
+                    const NodeId b = scalar(closed(*cmp.kids[1], Context::test), cmp.kids[1]->loc);
+                    const NodeId tol = scalar(closed(*e.within, Context::test), e.within->loc);
+                    x.truth = g_.op(Op::Le, g_.op(Op::Abs, g_.op(Op::Sub, a, b)), tol);
+                    x.shown = {a, b};
+                } else {
+                    const Value v = closed(*e.expr, Context::test);
+                    if (v.kind != ValueKind::boolean)
+                        fail(e.expr->loc, fmt::format("'expect' needs a condition, found {}", kind_name(v.kind)));
+                    x.truth = v.nodes[0];
+                    if (e.expr->kind == ExprKind::binary && e.expr->kids.size() == 2) {
+                        for (const ExprPtr& side : e.expr->kids) {
+                            const Value s = closed(*side, Context::test);
+                            if (s.kind == ValueKind::scalar) x.shown.push_back(s.nodes[0]);
+                        }
+                    }
+                }
+                t.expects.push_back(std::move(x));
+            });
+        }
+        m_.tests.push_back(std::move(t));
+    }
+
+    void print(const Item& it) {
+        const Value v = closed(*it.body, Context::test);
+        if (v.shape) fail(it.body->loc, "cannot print a shape; print enclose(shape, box) or its value at a point");
+        m_.prints.push_back({it.loc, v.kind, v.nodes, v.box});
+    }
+
+    // ---- scopes and inlining ----
+    using Scope = std::vector<std::pair<std::string, Value>>;
+
+    Value closed(const Expr& e, Context ctx) {
+        Frame f{ctx, {}, 0};
+        frames_.push_back(std::move(f));
+        frames_.back().scopes.emplace_back();
+        struct Pop {
+            std::vector<Frame>& f;
+            ~Pop() { f.pop_back(); }
+        } pop{frames_};
+        return expr(e);
+    }
+
+    // Inlines a function or shape body; `ctx` is what the body may use (a shape's body never runs queries).
+    Value inline_body(const Item& it, Scope params, Location call_loc, Context ctx) {
+        for (const Item* active : call_stack_)
+            if (active == &it)
+                fail(call_loc, fmt::format("recursive call of '{}': functions are inlined, so recursion is not "
+                                           "supported (write a series instead)", it.name));
+        if (static_cast<int>(call_stack_.size()) >= limits_.max_inline_depth)
+            fail(call_loc, fmt::format("calls nested deeper than the limit of {}", limits_.max_inline_depth));
+        // A body sees its parameters and the globals; series levels continue from the caller's.
+        const int level = frames_.empty() ? 0 : frames_.back().level;
+        frames_.push_back(Frame{ctx, {std::move(params)}, level});
+        call_stack_.push_back(&it);
+        struct Pop {
+            std::vector<Frame>& f;
+            std::vector<const Item*>& s;
+            ~Pop() {
+                f.pop_back();
+                s.pop_back();
+            }
+        } pop{frames_, call_stack_};
+        return expr(*it.body);
+    }
+
+    const Value* lookup_local(const std::string& name) const {
+        const Frame& f = frames_.back();
+        for (auto s = f.scopes.rbegin(); s != f.scopes.rend(); ++s)
+            for (auto b = s->rbegin(); b != s->rend(); ++b)
+                if (b->first == name) return &b->second;
+        return nullptr;
+    }
+
+    // ---- expressions ----
+    NodeId scalar(const Value& v, Location loc) {
+        if (v.shape) fail(loc, "a shape is not a number here; call it with coordinates");
+        if (v.kind == ValueKind::interval) return g_.constant(v.box[0], num::midpoint(v.box[0]));
+        if (v.kind != ValueKind::scalar) fail(loc, fmt::format("expected a number, found {}", kind_name(v.kind)));
+        return v.nodes[0];
+    }
+    NodeId boolean(const Value& v, Location loc) {
+        if (v.kind != ValueKind::boolean) fail(loc, fmt::format("expected a condition, found {}", kind_name(v.kind)));
+        return v.nodes[0];
+    }
+
+    Value expr(const Expr& e) {
+        switch (e.kind) {
+        case ExprKind::number: return number(e);
+        case ExprKind::name: return name(e);
+        case ExprKind::call: return call(e);
+        case ExprKind::unary: return unary(e);
+        case ExprKind::binary: return binary(e);
+        case ExprKind::if_: return if_expr(e);
+        case ExprKind::let: {
+            frames_.back().scopes.emplace_back();
+            for (const Binding& b : e.bindings) {
+                Value v = expr(*b.value);
+                frames_.back().scopes.back().emplace_back(b.name, std::move(v));
+            }
+            Value body = expr(*e.kids[0]);
+            frames_.back().scopes.pop_back();
+            return body;
+        }
+        case ExprKind::tuple: {
+            Value v;
+            v.kind = ValueKind::point;
+            if (e.kids.size() > 3) fail(e.loc, fmt::format("points have 2 or 3 coordinates, this one has {}", e.kids.size()));
+            for (const ExprPtr& k : e.kids) v.nodes.push_back(scalar(expr(*k), k->loc));
+            return v;
+        }
+        case ExprKind::field: {
+            const Value p = expr(*e.kids[0]);
+            if (p.kind != ValueKind::point) fail(e.loc, fmt::format("'.{}' needs a point, found {}", e.text, kind_name(p.kind)));
+            const std::size_t k = e.text == "x" ? 0 : e.text == "y" ? 1 : e.text == "z" ? 2 : 99;
+            if (k >= p.nodes.size())
+                fail(e.loc, fmt::format("a point of {} coordinates has no component '{}'", p.nodes.size(), e.text));
+            return Value::scalar(p.nodes[k]);
+        }
+        case ExprKind::interval: {
+            const NodeId lo = scalar(expr(*e.kids[0]), e.kids[0]->loc);
+            const NodeId hi = scalar(expr(*e.kids[1]), e.kids[1]->loc);
+            if (!g_.is_const(lo) || !g_.is_const(hi)) fail(e.loc, "the bounds of an interval must be constants");
+            const Interval v{g_[lo].value.lo, g_[hi].value.hi};
+            if (!(v.lo <= v.hi) || std::isnan(v.lo) || std::isnan(v.hi))
+                fail(e.loc, "the lower bound of an interval must not exceed its upper bound");
+            Value r;
+            r.kind = ValueKind::interval;
+            r.box = {v};
+            return r;
+        }
+        case ExprKind::series: return series(e);
+        }
+        throw InternalError("elaborate: unknown expression kind");
+    }
+
+    Value number(const Expr& e) {
+        const Interval v = num::from_decimal(e.text);
+        if (!std::isfinite(v.lo) || !std::isfinite(v.hi)) fail(e.loc, fmt::format("number '{}' is too large", e.text));
+        return Value::scalar(g_.constant(v, std::strtod(e.text.c_str(), nullptr)));
+    }
+
+    Value name(const Expr& e) {
+        if (const Value* v = lookup_local(e.text)) return *v;
+        if (auto g = globals_.find(e.text); g != globals_.end()) {
+            const Item& it = *g->second;
+            if (it.kind == ItemKind::const_) return const_value(it, e.loc);
+            if (it.kind == ItemKind::shape) {
+                Value v;
+                v.shape = &it;
+                return v;
+            }
+            fail(e.loc, fmt::format("'{}' is a function; call it with arguments", e.text));
+        }
+        if (e.text == "pi") return Value::scalar(g_.constant(num::pi(), M_PI));
+        if (e.text == "e") return Value::scalar(g_.constant(num::e(), M_E));
+        throw InternalError(fmt::format("unresolved name '{}'", e.text));
+    }
+
+    Value call(const Expr& e) {
+        if (auto g = globals_.find(e.text); g != globals_.end()) {
+            const Item& it = *g->second;
+            if (it.kind == ItemKind::fn) {
+                Scope params;
+                for (std::size_t i = 0; i < it.params.size(); ++i) params.emplace_back(it.params[i].name, expr(*e.args[i].value));
+                return inline_body(it, std::move(params), e.loc, frames_.back().ctx);
+            }
+            if (it.kind == ItemKind::shape) return Value::scalar(call_shape(it, e));
+            throw InternalError("call of a non-function");
+        }
+        const Builtin* b = find_builtin(e.text);
+        if (!b) throw InternalError(fmt::format("unresolved function '{}'", e.text));
+        auto arg = [&](std::size_t i) { return scalar(expr(*e.args[i].value), e.args[i].loc); };
+        switch (b->kind) {
+        case BuiltinKind::unary: return Value::scalar(g_.op(b->op, arg(0)));
+        case BuiltinKind::binary: return Value::scalar(g_.op(b->op, arg(0), arg(1)));
+        case BuiltinKind::variadic: {
+            NodeId acc = arg(0);
+            for (std::size_t i = 1; i < e.args.size(); ++i) acc = g_.op(b->op, acc, arg(i));
+            return Value::scalar(acc);
+        }
+        case BuiltinKind::mod: {
+            const NodeId x = arg(0), m = arg(1);
+            if (g_.is_const(m) && g_[m].value == Interval(1.0)) return Value::scalar(g_.op(Op::Mod1, x));
+            // x mod m = m * ((x / m) mod 1)
+            return Value::scalar(g_.op(Op::Mul, m, g_.op(Op::Mod1, g_.op(Op::Div, x, m))));
+        }
+        case BuiltinKind::pow: return Value::scalar(power(arg(0), arg(1)));
+        case BuiltinKind::enclose:
+        case BuiltinKind::dimension: return query(e, *b);
+        }
+        throw InternalError("unknown builtin kind");
+    }
+
+    NodeId call_shape(const Item& it, const Expr& e) {
+        const std::size_t idx = shape_info(it);
+        const int dim = m_.shapes[idx].dimension;
+        std::vector<Value> coords;
+        if (e.args.size() == 1) {
+            const Value p = expr(*e.args[0].value);
+            if (p.kind != ValueKind::point || static_cast<int>(p.nodes.size()) != dim)
+                fail(e.args[0].loc, fmt::format("shape '{}' takes {} coordinates or a point of {}", it.name, dim, dim));
+            for (NodeId n : p.nodes) coords.push_back(Value::scalar(n));
+        } else {
+            if (static_cast<int>(e.args.size()) != dim)
+                fail(e.loc, fmt::format("shape '{}' takes {} coordinates, {} given", it.name, dim, e.args.size()));
+            for (const Arg& a : e.args) coords.push_back(Value::scalar(scalar(expr(*a.value), a.loc)));
+        }
+        return shape_body(it, coords, e.loc);
+    }
+
+    Value query(const Expr& e, const Builtin& b) {
+        if (frames_.back().ctx != Context::test)
+            fail(e.loc, fmt::format("'{}' runs a computation on a shape; it is available in tests and print only", e.text));
+        const Value s = expr(*e.args[0].value);
+        if (!s.shape) fail(e.args[0].loc, fmt::format("'{}' needs a shape as its first argument", e.text));
+        Query q;
+        q.loc = e.loc;
+        q.shape = shape_info(*s.shape);
+        const ShapeInfo& info = m_.shapes[q.shape];
+        if (b.kind == BuiltinKind::enclose) {
+            const Value box = expr(*e.args[1].value);
+            if (box.kind != ValueKind::box) fail(e.args[1].loc, fmt::format("'enclose' needs a box, found {}", kind_name(box.kind)));
+            if (static_cast<int>(box.box.size()) != info.dimension)
+                fail(e.args[1].loc, fmt::format("shape '{}' has {} coordinates, the box has {} axes", info.name,
+                                                info.dimension, box.box.size()));
+            q.kind = Query::Kind::enclose;
+            q.box = box.box;
+        } else {
+            q.kind = Query::Kind::dimension;
+            q.box = info.box;
+            bool have_from = false, have_to = false;
+            for (std::size_t i = 1; i < e.args.size(); ++i) {
+                const Arg& a = e.args[i];
+                std::int64_t v = 0;
+                const NodeId n = scalar(expr(*a.value), a.loc);
+                if (!g_.const_integer(n, v)) fail(a.loc, fmt::format("'{}:' needs an integer constant", a.name));
+                if (a.name == "from") {
+                    q.from = static_cast<int>(v);
+                    have_from = true;
+                } else if (a.name == "to") {
+                    q.to = static_cast<int>(v);
+                    have_to = true;
+                } else if (a.name == "split") {
+                    q.split = static_cast<int>(v);
+                } else {
+                    fail(a.loc, "'dimension' takes named arguments from:, to: and split:");
+                }
+            }
+            if (!have_from || !have_to) fail(e.loc, "'dimension' needs from: and to: levels");
+            if (q.from < 0 || q.to <= q.from) fail(e.loc, "'dimension' needs 0 <= from < to");
+        }
+        m_.queries.push_back(q);
+        return Value::scalar(g_.var(static_cast<int>(m_.queries.size() - 1)));
+    }
+
+    NodeId power(NodeId base, NodeId exponent) {
+        std::int64_t k = 0;
+        if (g_.const_integer(exponent, k)) {
+            if (k == 1) return base;
+            if (k == 2) return g_.op(Op::Sqr, base);
+            return g_.op(Op::PowI, base, ir::no_node, ir::no_node, k);
+        }
+        return g_.op(Op::Pow, base, exponent);
+    }
+
+    Value unary(const Expr& e) {
+        const Value v = expr(*e.kids[0]);
+        switch (e.op) {
+        case Tok::kw_not: return Value::boolean(g_.op(Op::Not, boolean(v, e.kids[0]->loc)));
+        case Tok::plus:
+            if (v.kind == ValueKind::point) return v;
+            return Value::scalar(scalar(v, e.kids[0]->loc));
+        case Tok::minus:
+        case Tok::tilde: {
+            if (v.kind == ValueKind::point && e.op == Tok::minus) {
+                Value r = v;
+                for (NodeId& n : r.nodes) n = g_.op(Op::Neg, n);
+                return r;
+            }
+            return Value::scalar(g_.op(Op::Neg, scalar(v, e.kids[0]->loc)));
+        }
+        default: break;
+        }
+        throw InternalError("unknown unary operator");
+    }
+
+    Value binary(const Expr& e) {
+        const Location la = e.kids[0]->loc, lb = e.kids[1]->loc;
+        const Value a = expr(*e.kids[0]);
+        const Value b = expr(*e.kids[1]);
+        switch (e.op) {
+        case Tok::kw_and: return Value::boolean(g_.op(Op::And, boolean(a, la), boolean(b, lb)));
+        case Tok::kw_or: return Value::boolean(g_.op(Op::Or, boolean(a, la), boolean(b, lb)));
+        case Tok::lt: return Value::boolean(g_.op(Op::Lt, scalar(a, la), scalar(b, lb)));
+        case Tok::le: return Value::boolean(g_.op(Op::Le, scalar(a, la), scalar(b, lb)));
+        case Tok::gt: return Value::boolean(g_.op(Op::Gt, scalar(a, la), scalar(b, lb)));
+        case Tok::ge: return Value::boolean(g_.op(Op::Ge, scalar(a, la), scalar(b, lb)));
+        case Tok::eq: return Value::boolean(g_.op(Op::Eq, scalar(a, la), scalar(b, lb)));
+        case Tok::ne: return Value::boolean(g_.op(Op::Ne, scalar(a, la), scalar(b, lb)));
+        case Tok::amp: return Value::scalar(g_.op(Op::Max, scalar(a, la), scalar(b, lb)));
+        case Tok::bar: return Value::scalar(g_.op(Op::Min, scalar(a, la), scalar(b, lb)));
+        case Tok::caret: return Value::scalar(power(scalar(a, la), scalar(b, lb)));
+        case Tok::times: {
+            if (a.kind != ValueKind::interval && a.kind != ValueKind::box)
+                fail(la, fmt::format("'×' builds a box from intervals, found {}", kind_name(a.kind)));
+            if (b.kind != ValueKind::interval)
+                fail(lb, fmt::format("'×' builds a box from intervals, found {}", kind_name(b.kind)));
+            Value r;
+            r.kind = ValueKind::box;
+            r.box = a.box;
+            r.box.push_back(b.box[0]);
+            if (r.box.size() > 3) fail(e.loc, "boxes have 2 or 3 axes");
+            return r;
+        }
+        case Tok::plus:
+        case Tok::minus:
+        case Tok::star:
+        case Tok::slash: return arithmetic(e, a, b);
+        default: break;
+        }
+        throw InternalError("unknown binary operator");
+    }
+
+    Value arithmetic(const Expr& e, const Value& a, const Value& b) {
+        const Op op = e.op == Tok::plus ? Op::Add : e.op == Tok::minus ? Op::Sub : e.op == Tok::star ? Op::Mul : Op::Div;
+        const Location la = e.kids[0]->loc, lb = e.kids[1]->loc;
+        const bool pa = a.kind == ValueKind::point, pb = b.kind == ValueKind::point;
+        if (!pa && !pb) return Value::scalar(g_.op(op, scalar(a, la), scalar(b, lb)));
+        Value r;
+        r.kind = ValueKind::point;
+        if (pa && pb) {
+            if (op == Op::Mul || op == Op::Div) fail(e.loc, "points multiply or divide by numbers only");
+            if (a.nodes.size() != b.nodes.size()) fail(e.loc, "points of different dimensions");
+            for (std::size_t i = 0; i < a.nodes.size(); ++i) r.nodes.push_back(g_.op(op, a.nodes[i], b.nodes[i]));
+            return r;
+        }
+        if (op == Op::Add || op == Op::Sub) fail(e.loc, "a point and a number cannot be added; use a point");
+        if (pb && op == Op::Div) fail(e.loc, "a number cannot be divided by a point");
+        const Value& p = pa ? a : b;
+        const NodeId s = pa ? scalar(b, lb) : scalar(a, la);
+        for (NodeId n : p.nodes) r.nodes.push_back(pa ? g_.op(op, n, s) : g_.op(op, s, n));
+        return r;
+    }
+
+    Value if_expr(const Expr& e) {
+        const NodeId c = boolean(expr(*e.kids[0]), e.kids[0]->loc);
+        const Value a = expr(*e.kids[1]);
+        const Value b = expr(*e.kids[2]);
+        if (a.kind == ValueKind::interval || a.kind == ValueKind::box || a.shape)
+            fail(e.kids[1]->loc, fmt::format("'if' chooses between numbers, points or conditions, found {}", kind_name(a.kind)));
+        if (a.kind != b.kind || a.nodes.size() != b.nodes.size())
+            fail(e.kids[2]->loc, fmt::format("the branches of 'if' differ: {} and {}", kind_name(a.kind), kind_name(b.kind)));
+        Value r = a;
+        for (std::size_t i = 0; i < a.nodes.size(); ++i) r.nodes[i] = g_.op(Op::Select, c, a.nodes[i], b.nodes[i]);
+        return r;
+    }
+
+    Value series(const Expr& e) {
+        Frame& f = frames_.back();
+        auto integer = [&](const Expr& x, const char* what) {
+            const NodeId n = scalar(expr(x), x.loc);
+            std::int64_t v = 0;
+            if (!g_.const_integer(n, v)) fail(x.loc, fmt::format("the {} of a series index must be an integer constant", what));
+            return v;
+        };
+        ir::SeriesData data;
+        data.start = integer(*e.kids[0], "start");
+        const bool infinite = e.kids[1] == nullptr;
+        if (!infinite) {
+            data.end = integer(*e.kids[1], "end");
+            if (data.end < data.start) fail(e.loc, fmt::format("empty index range {}..{}", data.start, data.end));
+            if (data.end - data.start + 1 > limits_.max_finite_terms)
+                fail(e.loc, fmt::format("this series has {} terms, over the limit of {} (use an infinite series, whose "
+                                        "tail is bounded)", data.end - data.start + 1, limits_.max_finite_terms));
+        } else if (data.start < 0) {
+            fail(e.kids[0]->loc, "an infinite series must start at an index >= 0");
+        }
+        if (f.level + 1 > limits_.max_series_nesting)
+            fail(e.loc, fmt::format("series nested deeper than the limit of {}", limits_.max_series_nesting));
+        data.level = ++f.level;
+        f.scopes.emplace_back();
+        f.scopes.back().emplace_back(e.var, Value::scalar(g_.index(data.level)));
+        struct Restore {
+            Frame& f;
+            ~Restore() {
+                f.scopes.pop_back();
+                --f.level;
+            }
+        } restore{f};
+        const NodeId body = scalar(expr(*e.kids[2]), e.kids[2]->loc);
+        const Op kind = e.text == "sum" ? Op::SeriesSum : e.text == "min" ? Op::SeriesMin : Op::SeriesMax;
+        if (!infinite) return Value::scalar(g_.series(kind, data, body, ir::no_node, ir::no_node));
+        std::string why;
+        std::optional<TermBound> bound;
+        {
+            num::UpwardRounding up;
+            bound = bound_series_term(g_, body, data.level, why);
+        }
+        if (!bound) fail(e.loc, "cannot bound this infinite series: " + why);
+        data.gamma = bound->gamma;
+        return Value::scalar(g_.series(kind, data, body, bound->a, bound->b));
+    }
+
+    struct Frame {
+        Context ctx;
+        std::vector<Scope> scopes;
+        int level = 0; // series nesting
+    };
+
+    static constexpr std::size_t in_progress = static_cast<std::size_t>(-1);
+    const Program& p_;
+    const SourceManager& sm_;
+    Limits limits_;
+    Module& m_;
+    ir::Graph& g_;
+    Diagnostics& d_;
+    std::unordered_map<std::string, const Item*> globals_;
+    std::unordered_map<const Item*, std::size_t> shape_index_;
+    std::unordered_map<const Item*, std::optional<Value>> consts_;
+    std::unordered_set<const Item*> failed_consts_;
+    std::vector<Frame> frames_;
+    std::vector<const Item*> call_stack_;
+};
+
+} // namespace
+
+void elaborate(const Program& program, const SourceManager& sources, const Limits& limits, Module& out,
+               Diagnostics& diags) {
+    Elaborator(program, sources, limits, out, diags).run();
+}
+
+} // namespace frac::front

@@ -1,0 +1,34 @@
+// Tokens of the Frac language (grammar/frac.ebnf).
+#pragma once
+
+#include "frontend/diagnostics.hpp"
+
+#include <string>
+#include <vector>
+
+namespace frac::front {
+
+enum class Tok {
+    end, ident, number, string,
+    // keywords
+    kw_fn, kw_const, kw_let, kw_in, kw_if, kw_then, kw_else, kw_and, kw_or, kw_not, kw_shape, kw_over,
+    kw_test, kw_expect, kw_within, kw_import, kw_print,
+    // punctuation
+    lparen, rparen, lbracket, rbracket, lbrace, rbrace, comma, semicolon, colon, dot, dotdot, assign,
+    eq, ne, lt, le, gt, ge, plus, minus, star, slash, caret, amp, bar, tilde, times,
+    error
+};
+
+const char* token_name(Tok t);
+
+struct Token {
+    Tok kind = Tok::end;
+    std::string text;
+    Location loc;
+};
+
+// Splits a file into tokens; malformed characters and unterminated strings or comments are reported
+// to `diags` and skipped.
+std::vector<Token> lex(const std::string& text, std::uint32_t file, Diagnostics& diags);
+
+} // namespace frac::front

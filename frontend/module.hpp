@@ -1,0 +1,69 @@
+// What the frontend produces from a model: the expression graph and, over it, the shapes, tests and
+// print statements of the model.
+#pragma once
+
+#include "frontend/diagnostics.hpp"
+#include "ir/graph.hpp"
+
+#include <string>
+#include <vector>
+
+namespace frac::front {
+
+using ir::Interval;
+using ir::NodeId;
+
+struct ShapeInfo {
+    std::string name;
+    Location loc;
+    int dimension = 2;
+    std::vector<Interval> box; // default view box, one interval per axis
+    NodeId root = ir::no_node; // reads Var(k) = coordinate k
+};
+
+// A run-time question a test asks of a shape; its answer is the input Var(index) of test graphs.
+struct Query {
+    enum class Kind { enclose, dimension } kind = Kind::enclose;
+    Location loc;
+    std::size_t shape = 0;          // index into Module::shapes
+    std::vector<Interval> box;      // enclose: the box; dimension: the root box
+    int from = 0, to = 0, split = 2; // dimension: levels used for box counting
+};
+
+enum class ValueKind { scalar, boolean, point, interval, box };
+
+struct Expectation {
+    Location loc;
+    std::string source;              // the expression's source line, for messages
+    NodeId truth = ir::no_node;      // boolean: must evaluate to proven true
+    std::vector<NodeId> shown;       // values printed when it fails
+};
+
+struct TestInfo {
+    std::string name;
+    Location loc;
+    std::vector<Expectation> expects;
+};
+
+struct PrintInfo {
+    Location loc;
+    ValueKind kind = ValueKind::scalar;
+    std::vector<NodeId> nodes;  // scalar/boolean: 1; point: its components
+    std::vector<Interval> box;  // interval/box values
+};
+
+struct Module {
+    ir::Graph graph;
+    std::vector<ShapeInfo> shapes;
+    std::vector<Query> queries;
+    std::vector<TestInfo> tests;
+    std::vector<PrintInfo> prints;
+
+    const ShapeInfo* find_shape(const std::string& name) const {
+        for (const ShapeInfo& s : shapes)
+            if (s.name == name) return &s;
+        return nullptr;
+    }
+};
+
+} // namespace frac::front

@@ -1,0 +1,403 @@
+// Recursive-descent parser for grammar/frac.ebnf. One function per production.
+#include "frontend/ast.hpp"
+
+#include <fmt/format.h>
+
+namespace frac::front {
+
+namespace {
+
+class Parser {
+public:
+    Parser(const std::vector<Token>& tokens, Diagnostics& diags) : t_(tokens), diags_(diags) {}
+
+    Program program() {
+        Program p;
+        while (!at(Tok::end)) {
+            depth_ = 0;
+            try {
+                p.items.push_back(item());
+            } catch (const CompileError& e) {
+                diags_.error(e.loc, e.what());
+                synchronize();
+            }
+        }
+        return p;
+    }
+
+private:
+    // ---- token helpers ----
+    const Token& cur() const { return t_[pos_]; }
+    const Token& ahead(std::size_t k) const { return t_[std::min(pos_ + k, t_.size() - 1)]; }
+    bool at(Tok k) const { return cur().kind == k; }
+    const Token& take() {
+        const Token& tok = t_[pos_];
+        if (pos_ + 1 < t_.size()) ++pos_;
+        return tok;
+    }
+    bool accept(Tok k) {
+        if (!at(k)) return false;
+        take();
+        return true;
+    }
+    const Token& expect(Tok k, const char* what) {
+        if (!at(k)) fail(fmt::format("expected {} {}, found {}", token_name(k), what, describe(cur())));
+        return take();
+    }
+    static std::string describe(const Token& tok) {
+        if (tok.kind == Tok::ident || tok.kind == Tok::number) return fmt::format("'{}'", tok.text);
+        return token_name(tok.kind);
+    }
+    [[noreturn]] void fail(const std::string& message) const { throw CompileError(cur().loc, message); }
+
+    // Skips to the start of the next item after a syntax error.
+    void synchronize() {
+        int depth = 0;
+        while (!at(Tok::end)) {
+            const Tok k = cur().kind;
+            if (depth == 0 && (k == Tok::kw_fn || k == Tok::kw_const || k == Tok::kw_shape || k == Tok::kw_test ||
+                               k == Tok::kw_import || k == Tok::kw_print))
+                return;
+            take();
+            if (k == Tok::lbrace) ++depth;
+            if (k == Tok::rbrace && --depth <= 0) {
+                depth = 0;
+                if (at(Tok::semicolon)) take();
+                return;
+            }
+            if (k == Tok::semicolon && depth == 0) return;
+        }
+    }
+
+    // ---- items ----
+    Item item() {
+        Item it;
+        it.loc = cur().loc;
+        switch (cur().kind) {
+        case Tok::kw_import:
+            take();
+            it.kind = ItemKind::import;
+            it.name = expect(Tok::string, "after 'import'").text;
+            expect(Tok::semicolon, "after the import");
+            return it;
+        case Tok::kw_fn:
+            take();
+            it.kind = ItemKind::fn;
+            it.name = expect(Tok::ident, "after 'fn'").text;
+            expect(Tok::lparen, "before the parameters");
+            it.params = params();
+            it.has_params = true;
+            expect(Tok::assign, "before the function body");
+            it.body = expr();
+            expect(Tok::semicolon, "after the function");
+            return it;
+        case Tok::kw_const:
+            take();
+            it.kind = ItemKind::const_;
+            it.name = expect(Tok::ident, "after 'const'").text;
+            expect(Tok::assign, "in the constant");
+            it.body = expr();
+            expect(Tok::semicolon, "after the constant");
+            return it;
+        case Tok::kw_shape:
+            take();
+            it.kind = ItemKind::shape;
+            it.name = expect(Tok::ident, "after 'shape'").text;
+            if (accept(Tok::lparen)) {
+                it.params = params();
+                it.has_params = true;
+            }
+            if (accept(Tok::kw_over)) it.over = expr();
+            expect(Tok::assign, "before the shape's function");
+            it.body = expr();
+            expect(Tok::semicolon, "after the shape");
+            return it;
+        case Tok::kw_test:
+            take();
+            it.kind = ItemKind::test;
+            it.name = expect(Tok::string, "(the test's name) after 'test'").text;
+            expect(Tok::lbrace, "to open the test");
+            while (!at(Tok::rbrace) && !at(Tok::end)) {
+                try {
+                    it.expects.push_back(expect_stmt());
+                } catch (const CompileError& e) {
+                    diags_.error(e.loc, e.what());
+                    while (!at(Tok::semicolon) && !at(Tok::rbrace) && !at(Tok::end)) take();
+                    accept(Tok::semicolon);
+                }
+            }
+            expect(Tok::rbrace, "to close the test");
+            return it;
+        case Tok::kw_print:
+            take();
+            it.kind = ItemKind::print;
+            it.body = expr();
+            expect(Tok::semicolon, "after print");
+            return it;
+        default:
+            fail(fmt::format("expected a definition (fn, const, shape, test, import or print), found {}",
+                             describe(cur())));
+        }
+    }
+
+    std::vector<Param> params() {
+        std::vector<Param> ps;
+        if (accept(Tok::rparen)) return ps;
+        do {
+            const Token& name = expect(Tok::ident, "as a parameter name");
+            ps.push_back({name.text, name.loc});
+        } while (accept(Tok::comma));
+        expect(Tok::rparen, "after the parameters");
+        return ps;
+    }
+
+    Expect expect_stmt() {
+        Expect e;
+        e.loc = expect(Tok::kw_expect, "in a test").loc;
+        e.expr = expr();
+        if (accept(Tok::kw_within)) e.within = expr();
+        expect(Tok::semicolon, "after the expectation");
+        return e;
+    }
+
+    // ---- expressions, lowest precedence first ----
+    ExprPtr make(ExprKind k, Location loc) {
+        auto e = std::make_unique<Expr>();
+        e->kind = k;
+        e->loc = loc;
+        return e;
+    }
+    ExprPtr binary(Tok op, Location loc, ExprPtr a, ExprPtr b) {
+        auto e = make(ExprKind::binary, loc);
+        e->op = op;
+        e->kids.push_back(std::move(a));
+        e->kids.push_back(std::move(b));
+        return e;
+    }
+
+    ExprPtr expr() {
+        if (++depth_ > max_nesting) fail(fmt::format("expression nested deeper than {} levels", max_nesting));
+        ExprPtr e;
+        if (at(Tok::kw_let)) {
+            e = make(ExprKind::let, take().loc);
+            do {
+                const Token& name = expect(Tok::ident, "after 'let'");
+                expect(Tok::assign, "in the let binding");
+                e->bindings.push_back({name.text, name.loc, expr()});
+            } while (accept(Tok::comma));
+            expect(Tok::kw_in, "after the let bindings");
+            e->kids.push_back(expr());
+        } else if (at(Tok::kw_if)) {
+            e = make(ExprKind::if_, take().loc);
+            e->kids.push_back(expr());
+            expect(Tok::kw_then, "after the condition");
+            e->kids.push_back(expr());
+            expect(Tok::kw_else, "in the if expression");
+            e->kids.push_back(expr());
+        } else {
+            e = or_expr();
+        }
+        --depth_;
+        return e;
+    }
+
+    ExprPtr or_expr() {
+        ExprPtr e = and_expr();
+        while (at(Tok::kw_or)) {
+            const Location loc = take().loc;
+            e = binary(Tok::kw_or, loc, std::move(e), and_expr());
+        }
+        return e;
+    }
+    ExprPtr and_expr() {
+        ExprPtr e = not_expr();
+        while (at(Tok::kw_and)) {
+            const Location loc = take().loc;
+            e = binary(Tok::kw_and, loc, std::move(e), not_expr());
+        }
+        return e;
+    }
+    ExprPtr not_expr() {
+        if (at(Tok::kw_not)) {
+            auto e = make(ExprKind::unary, take().loc);
+            e->op = Tok::kw_not;
+            e->kids.push_back(not_expr());
+            return e;
+        }
+        return cmp_expr();
+    }
+    ExprPtr cmp_expr() {
+        ExprPtr e = union_expr();
+        const Tok k = cur().kind;
+        if (k == Tok::lt || k == Tok::le || k == Tok::gt || k == Tok::ge || k == Tok::eq || k == Tok::ne) {
+            const Location loc = take().loc;
+            e = binary(k, loc, std::move(e), union_expr());
+            const Tok again = cur().kind;
+            if (again == Tok::lt || again == Tok::le || again == Tok::gt || again == Tok::ge || again == Tok::eq ||
+                again == Tok::ne)
+                fail("comparisons do not chain; combine them with 'and'");
+        }
+        return e;
+    }
+    ExprPtr union_expr() {
+        ExprPtr e = inter_expr();
+        while (at(Tok::bar)) {
+            const Location loc = take().loc;
+            e = binary(Tok::bar, loc, std::move(e), inter_expr());
+        }
+        return e;
+    }
+    ExprPtr inter_expr() {
+        ExprPtr e = box_expr();
+        while (at(Tok::amp)) {
+            const Location loc = take().loc;
+            e = binary(Tok::amp, loc, std::move(e), box_expr());
+        }
+        return e;
+    }
+    ExprPtr box_expr() {
+        ExprPtr e = add_expr();
+        while (at(Tok::times)) {
+            const Location loc = take().loc;
+            e = binary(Tok::times, loc, std::move(e), add_expr());
+        }
+        return e;
+    }
+    ExprPtr add_expr() {
+        ExprPtr e = mul_expr();
+        while (at(Tok::plus) || at(Tok::minus)) {
+            const Tok k = cur().kind;
+            const Location loc = take().loc;
+            e = binary(k, loc, std::move(e), mul_expr());
+        }
+        return e;
+    }
+    ExprPtr mul_expr() {
+        ExprPtr e = unary_expr();
+        while (at(Tok::star) || at(Tok::slash)) {
+            const Tok k = cur().kind;
+            const Location loc = take().loc;
+            e = binary(k, loc, std::move(e), unary_expr());
+        }
+        return e;
+    }
+    ExprPtr unary_expr() {
+        if (at(Tok::minus) || at(Tok::plus) || at(Tok::tilde)) {
+            if (++depth_ > max_nesting) fail(fmt::format("expression nested deeper than {} levels", max_nesting));
+            const Tok k = cur().kind;
+            auto e = make(ExprKind::unary, take().loc);
+            e->op = k;
+            e->kids.push_back(unary_expr());
+            --depth_;
+            return e;
+        }
+        return power_expr();
+    }
+    ExprPtr power_expr() {
+        ExprPtr base = postfix_expr();
+        if (at(Tok::caret)) {
+            const Location loc = take().loc;
+            return binary(Tok::caret, loc, std::move(base), unary_expr()); // right associative
+        }
+        return base;
+    }
+    ExprPtr postfix_expr() {
+        ExprPtr e = primary();
+        while (at(Tok::dot)) {
+            const Location loc = take().loc;
+            auto f = make(ExprKind::field, loc);
+            f->text = expect(Tok::ident, "after '.'").text;
+            f->kids.push_back(std::move(e));
+            e = std::move(f);
+        }
+        return e;
+    }
+
+    ExprPtr primary() {
+        const Token& tok = cur();
+        switch (tok.kind) {
+        case Tok::number: {
+            auto e = make(ExprKind::number, tok.loc);
+            e->text = take().text;
+            return e;
+        }
+        case Tok::ident: {
+            const Token& name = take();
+            if (!at(Tok::lparen)) {
+                auto e = make(ExprKind::name, name.loc);
+                e->text = name.text;
+                return e;
+            }
+            take();
+            if ((name.text == "sum" || name.text == "min" || name.text == "max") && at(Tok::ident) &&
+                ahead(1).kind == Tok::kw_in)
+                return series(name);
+            auto e = make(ExprKind::call, name.loc);
+            e->text = name.text;
+            if (!accept(Tok::rparen)) {
+                do {
+                    Arg a;
+                    a.loc = cur().loc;
+                    if (at(Tok::ident) && ahead(1).kind == Tok::colon) {
+                        a.name = take().text;
+                        take();
+                    }
+                    a.value = expr();
+                    e->args.push_back(std::move(a));
+                } while (accept(Tok::comma));
+                expect(Tok::rparen, "after the arguments");
+            }
+            return e;
+        }
+        case Tok::lparen: {
+            const Location loc = take().loc;
+            ExprPtr first = expr();
+            if (!at(Tok::comma)) {
+                expect(Tok::rparen, "to close the parenthesis");
+                return first;
+            }
+            auto e = make(ExprKind::tuple, loc);
+            e->kids.push_back(std::move(first));
+            while (accept(Tok::comma)) e->kids.push_back(expr());
+            expect(Tok::rparen, "to close the point");
+            return e;
+        }
+        case Tok::lbracket: {
+            auto e = make(ExprKind::interval, take().loc);
+            e->kids.push_back(expr());
+            expect(Tok::comma, "between the interval's bounds");
+            e->kids.push_back(expr());
+            expect(Tok::rbracket, "to close the interval");
+            return e;
+        }
+        default: fail(fmt::format("expected an expression, found {}", describe(tok)));
+        }
+    }
+
+    // sum(i in a.., body), min(i in a..b, body), max(...)
+    ExprPtr series(const Token& name) {
+        auto e = make(ExprKind::series, name.loc);
+        e->text = name.text;
+        e->var = take().text;
+        expect(Tok::kw_in, "after the series index");
+        e->kids.push_back(add_expr());
+        expect(Tok::dotdot, "in the index range");
+        e->kids.push_back(at(Tok::comma) ? nullptr : add_expr());
+        expect(Tok::comma, "after the index range");
+        e->kids.push_back(expr());
+        expect(Tok::rparen, "to close the series");
+        return e;
+    }
+
+    static constexpr int max_nesting = 200;
+    const std::vector<Token>& t_;
+    Diagnostics& diags_;
+    std::size_t pos_ = 0;
+    int depth_ = 0;
+};
+
+} // namespace
+
+Program parse(const std::vector<Token>& tokens, Diagnostics& diags) { return Parser(tokens, diags).program(); }
+
+} // namespace frac::front

@@ -1,0 +1,55 @@
+// The interface every backend implements (interpreter, LLVM JIT). The runtime sees compiled shapes
+// only through it, so every algorithm runs with every engine.
+#pragma once
+
+#include "runtime/numeric/interval.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+namespace frac::ir {
+
+using num::Interval;
+
+// Limits every engine honours.
+struct EvalOptions {
+    // Most terms summed of an infinite series before its tail bound takes over (sound either way).
+    int max_terms = 128;
+};
+inline constexpr int max_terms_limit = 100000;
+
+// Counters an evaluator keeps (reset by the caller when it wants per-run numbers).
+struct EvalStats {
+    std::uint64_t calls = 0;        // point or box evaluations
+    std::uint64_t series_terms = 0; // series terms evaluated in total
+    std::uint64_t series_capped = 0; // series stopped by the term limit, not by resolution
+};
+
+class Evaluator {
+public:
+    virtual ~Evaluator() = default;
+
+    // Number of coordinates the shape takes (2 or 3; 0 for a closed expression).
+    virtual int dimension() const = 0;
+    // Name of the engine ("interp", "jit").
+    virtual std::string engine() const = 0;
+
+    // Value at a point (round to nearest; series summed until their tail is below an ulp).
+    virtual double eval_point(const double* coords) = 0;
+    // Guaranteed enclosure of the values over a box: contains f(p) for every p in the box.
+    // Sets upward rounding itself.
+    virtual Interval eval_box(const Interval* box) = 0;
+
+    // Batches: `coords` / `boxes` hold n consecutive groups of dimension() values.
+    virtual void eval_points(const double* coords, std::size_t n, double* out);
+    virtual void eval_boxes(const Interval* boxes, std::size_t n, Interval* out);
+
+    // An independent evaluator of the same function, for use on another thread.
+    virtual std::unique_ptr<Evaluator> clone() const = 0;
+
+    EvalStats stats;
+};
+
+} // namespace frac::ir

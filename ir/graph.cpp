@@ -1,0 +1,155 @@
+#include "ir/graph.hpp"
+
+#include "ir/semantics.hpp"
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+namespace frac::ir {
+
+namespace {
+
+struct OpInfo {
+    int arity;
+    const char* name;
+    OpClass cls;
+};
+
+constexpr OpInfo op_table[] = {
+#define FRAC_OP(name, arity, text, cls) {arity, text, OpClass::cls},
+#include "ir/opcodes.def"
+#undef FRAC_OP
+};
+
+std::uint64_t bits(double v) { return std::bit_cast<std::uint64_t>(v); }
+
+void mix(std::size_t& h, std::uint64_t v) { h ^= std::hash<std::uint64_t>{}(v) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2); }
+
+} // namespace
+
+int arity(Op op) { return op_table[static_cast<int>(op)].arity; }
+const char* op_name(Op op) { return op_table[static_cast<int>(op)].name; }
+OpClass op_class(Op op) { return op_table[static_cast<int>(op)].cls; }
+
+std::size_t Graph::KeyHash::operator()(const Node& n) const {
+    std::size_t h = static_cast<std::size_t>(n.op);
+    for (NodeId a : n.args) mix(h, a);
+    mix(h, bits(n.value.lo));
+    mix(h, bits(n.value.hi));
+    mix(h, bits(n.point));
+    mix(h, static_cast<std::uint64_t>(n.imm));
+    mix(h, static_cast<std::uint64_t>(n.series.level));
+    mix(h, static_cast<std::uint64_t>(n.series.start));
+    mix(h, static_cast<std::uint64_t>(n.series.end));
+    return h;
+}
+
+bool Graph::KeyEq::operator()(const Node& a, const Node& b) const {
+    // Bitwise comparison of doubles, so that -0 and 0 (and NaN payloads) stay distinct constants.
+    return a.op == b.op && a.args == b.args && bits(a.value.lo) == bits(b.value.lo) &&
+           bits(a.value.hi) == bits(b.value.hi) && bits(a.point) == bits(b.point) && a.imm == b.imm &&
+           a.series.level == b.series.level && a.series.start == b.series.start &&
+           a.series.end == b.series.end && bits(a.series.gamma.lo) == bits(b.series.gamma.lo) &&
+           bits(a.series.gamma.hi) == bits(b.series.gamma.hi);
+}
+
+NodeId Graph::intern(const Node& n) {
+    auto it = index_.find(n);
+    if (it != index_.end()) return it->second;
+    Node stored = n;
+    stored.index_mask = 0;
+    for (NodeId a : n.args)
+        if (a != no_node) stored.index_mask |= nodes_[a].index_mask;
+    if (n.op == Op::Index) stored.index_mask = std::uint64_t{1} << n.imm;
+    if (is_series(n.op)) stored.index_mask &= ~(std::uint64_t{1} << n.series.level);
+    const auto id = static_cast<NodeId>(nodes_.size());
+    nodes_.push_back(stored);
+    index_.emplace(stored, id);
+    return id;
+}
+
+NodeId Graph::constant(Interval value, double point) {
+    Node n;
+    n.op = Op::Const;
+    n.value = value;
+    n.point = point;
+    return intern(n);
+}
+
+NodeId Graph::var(int index) {
+    Node n;
+    n.op = Op::Var;
+    n.imm = index;
+    return intern(n);
+}
+
+NodeId Graph::index(int level) {
+    if (level < 1 || level > 63) throw std::invalid_argument("series nesting level out of range");
+    Node n;
+    n.op = Op::Index;
+    n.imm = level;
+    return intern(n);
+}
+
+NodeId Graph::fold(const Node& n) {
+    const int k = arity(n.op);
+    Interval iv[3];
+    double pt[3];
+    for (int i = 0; i < k; ++i) {
+        iv[i] = nodes_[n.args[i]].value;
+        pt[i] = nodes_[n.args[i]].point;
+    }
+    Interval value;
+    {
+        num::UpwardRounding up;
+        value = apply_interval(n.op, iv, n.imm);
+    }
+    return constant(value, apply_point(n.op, pt, n.imm));
+}
+
+NodeId Graph::op(Op op, NodeId a, NodeId b, NodeId c, std::int64_t imm) {
+    if (op_class(op) == OpClass::leaf || is_series(op))
+        throw std::logic_error(std::string("Graph::op: use the dedicated constructor for ") + op_name(op));
+    const NodeId args[3] = {a, b, c};
+    Node n;
+    n.op = op;
+    n.imm = imm;
+    bool all_const = true;
+    for (int i = 0; i < 3; ++i) {
+        const bool wanted = i < arity(op);
+        if (wanted != (args[i] != no_node) || (wanted && args[i] >= nodes_.size()))
+            throw std::logic_error(std::string("Graph::op: bad arguments for ") + op_name(op));
+        n.args[static_cast<std::size_t>(i)] = args[i];
+        if (wanted) all_const = all_const && is_const(args[i]);
+    }
+    if (all_const) return fold(n);
+    // A select on a decided condition is its branch.
+    if (op == Op::Select && is_const(a)) {
+        const Interval cond = nodes_[a].value;
+        if (cond == tv_true) return b;
+        if (cond == tv_false) return c;
+    }
+    return intern(n);
+}
+
+NodeId Graph::series(Op kind, const SeriesData& data, NodeId body, NodeId tail_a, NodeId tail_b) {
+    if (!is_series(kind)) throw std::logic_error("Graph::series: not a series op");
+    Node n;
+    n.op = kind;
+    n.series = data;
+    n.args = {body, tail_a, tail_b};
+    return intern(n);
+}
+
+bool Graph::const_integer(NodeId id, std::int64_t& value) const {
+    const Node& n = nodes_[id];
+    if (n.op != Op::Const || !n.value.is_thin() || std::floor(n.value.lo) != n.value.lo ||
+        std::fabs(n.value.lo) > 9.0e15)
+        return false;
+    value = static_cast<std::int64_t>(n.value.lo);
+    return true;
+}
+
+} // namespace frac::ir

@@ -1,0 +1,95 @@
+// The expression graph: hash-consed, constant-folded nodes in topological order (an argument's id is
+// always smaller than its user's). Functions and lets are inlined by the frontend before they get here.
+#pragma once
+
+#include "runtime/numeric/interval.hpp"
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace frac::ir {
+
+using num::Interval;
+
+enum class Op : std::uint8_t {
+#define FRAC_OP(name, arity, text, cls) name,
+#include "ir/opcodes.def"
+#undef FRAC_OP
+};
+
+enum class OpClass : std::uint8_t { leaf, arith, logic, series };
+
+int arity(Op op);
+const char* op_name(Op op);
+OpClass op_class(Op op);
+inline bool is_series(Op op) { return op_class(op) == OpClass::series; }
+
+using NodeId = std::uint32_t;
+inline constexpr NodeId no_node = std::numeric_limits<NodeId>::max();
+inline constexpr std::int64_t infinite_end = std::numeric_limits<std::int64_t>::max();
+
+// What an infinite series needs for its tail: every term t_i (i >= start) lies in (A + B i) gamma^i,
+// with A and B enclosed by evaluating the nodes tail_a / tail_b over the current box (B may be absent)
+// and 0 < gamma < 1. The frontend proves this form (frontend/series_bounds).
+struct SeriesData {
+    int level = 0;           // nesting level; the body reads the index with Index(level)
+    std::int64_t start = 0;
+    std::int64_t end = infinite_end; // inclusive; infinite_end for an infinite series
+    Interval gamma{0.0, 0.0};         // decay, proven 0 < gamma.hi < 1 for infinite series
+    bool operator==(const SeriesData&) const = default;
+};
+
+struct Node {
+    Op op = Op::Const;
+    std::array<NodeId, 3> args{no_node, no_node, no_node};
+    Interval value{0.0, 0.0}; // Const: outward enclosure of the constant
+    double point = 0.0;       // Const: its round-to-nearest value
+    std::int64_t imm = 0;     // Var: input index; Index: level; PowI: exponent
+    SeriesData series;        // series ops only
+    // Bit L set when the node depends on the index of series level L (L >= 1); bit 0 unused.
+    std::uint64_t index_mask = 0;
+};
+
+class Graph {
+public:
+    const Node& operator[](NodeId id) const { return nodes_[id]; }
+    std::size_t size() const { return nodes_.size(); }
+
+    NodeId constant(Interval value, double point);
+    NodeId constant(double exact) { return constant(Interval{exact, exact}, exact); }
+    NodeId var(int index);
+    NodeId index(int level);
+    // An operation; folds constants and a few identities, and returns an existing node when it has one.
+    NodeId op(Op op, NodeId a, NodeId b = no_node, NodeId c = no_node, std::int64_t imm = 0);
+    NodeId series(Op kind, const SeriesData& data, NodeId body, NodeId tail_a, NodeId tail_b);
+
+    bool is_const(NodeId id) const { return nodes_[id].op == Op::Const; }
+    // True when the node is a thin integer constant; sets `value`.
+    bool const_integer(NodeId id, std::int64_t& value) const;
+
+private:
+    NodeId intern(const Node& n);
+    NodeId fold(const Node& n);
+
+    struct KeyHash {
+        std::size_t operator()(const Node& n) const;
+    };
+    struct KeyEq {
+        bool operator()(const Node& a, const Node& b) const;
+    };
+    std::vector<Node> nodes_;
+    std::unordered_map<Node, NodeId, KeyHash, KeyEq> index_;
+};
+
+// Text form of the sub-graph reachable from `roots`, one node a line ("%4 = add %2, %3").
+std::string print_graph(const Graph& g, const std::vector<NodeId>& roots);
+
+// Structural checks (arities, topological order, index levels, series invariants).
+// Returns an empty string when the graph is well formed, else a description of the first defect.
+std::string verify_graph(const Graph& g);
+
+} // namespace frac::ir

@@ -1,0 +1,55 @@
+// Text form of the expression graph (frac check --emit=ir).
+#include "ir/graph.hpp"
+
+#include <algorithm>
+#include <fmt/format.h>
+
+namespace frac::ir {
+
+std::string print_graph(const Graph& g, const std::vector<NodeId>& roots) {
+    std::vector<bool> live(g.size(), false);
+    std::vector<NodeId> stack(roots.begin(), roots.end());
+    while (!stack.empty()) {
+        const NodeId id = stack.back();
+        stack.pop_back();
+        if (id == no_node || live[id]) continue;
+        live[id] = true;
+        for (NodeId a : g[id].args)
+            if (a != no_node) stack.push_back(a);
+    }
+    std::string out;
+    for (NodeId id = 0; id < g.size(); ++id) {
+        if (!live[id]) continue;
+        const Node& n = g[id];
+        out += fmt::format("%{} = {}", id, op_name(n.op));
+        switch (op_class(n.op)) {
+        case OpClass::leaf:
+            if (n.op == Op::Const)
+                out += n.value.is_thin() ? fmt::format(" {}", n.value.lo)
+                                         : fmt::format(" [{}, {}] ~{}", n.value.lo, n.value.hi, n.point);
+            else
+                out += fmt::format(" {}", n.imm);
+            break;
+        case OpClass::arith:
+        case OpClass::logic:
+            for (int i = 0; i < arity(n.op); ++i) out += fmt::format("{} %{}", i ? "," : "", n.args[static_cast<std::size_t>(i)]);
+            if (n.op == Op::PowI) out += fmt::format(", {}", n.imm);
+            break;
+        case OpClass::series: {
+            const SeriesData& s = n.series;
+            const std::string end = s.end == infinite_end ? "inf" : fmt::format("{}", s.end);
+            out += fmt::format(" level {} in {}..{} term %{}", s.level, s.start, end, n.args[0]);
+            if (s.end == infinite_end) {
+                const std::string b = n.args[2] == no_node ? "0" : fmt::format("%{}", n.args[2]);
+                out += fmt::format(" tail (%{} + {} i) * [{}, {}]^i", n.args[1], b, s.gamma.lo, s.gamma.hi);
+            }
+            break;
+        }
+        }
+        if (std::find(roots.begin(), roots.end(), id) != roots.end()) out += "   ; root";
+        out += "\n";
+    }
+    return out;
+}
+
+} // namespace frac::ir

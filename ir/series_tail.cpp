@@ -1,0 +1,72 @@
+#include "ir/series_tail.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace frac::ir {
+
+using namespace frac::num;
+
+Interval series_term_bound(Interval a, Interval b, bool has_b, Interval gamma_i, std::int64_t i) {
+    const Interval coeff = has_b ? add(a, mul(b, Interval(static_cast<double>(i)))) : a;
+    return mul(coeff, gamma_i);
+}
+
+Interval series_tail(Op kind, Interval a, Interval b, bool has_b, Interval gamma, std::int64_t n) {
+    const Interval g1 = powi(gamma, n + 1); // gamma^(n+1)
+    const Interval one_minus = sub(Interval(1.0), gamma);
+    const Interval s0 = div(g1, one_minus); // sum_{i>n} gamma^i
+    // sum_{i>n} i gamma^i = gamma^(n+1) ((n+1) - n gamma) / (1 - gamma)^2
+    const auto nd = static_cast<double>(n);
+    const Interval s1 = has_b ? div(mul(g1, sub(Interval(nd + 1.0), mul(Interval(nd), gamma))), sqr(one_minus))
+                              : Interval(0.0);
+    switch (kind) {
+    case Op::SeriesSum: return has_b ? add(mul(a, s0), mul(b, s1)) : mul(a, s0);
+    case Op::SeriesMin: {
+        const Interval first = series_term_bound(a, b, has_b, g1, n + 1);
+        double lo;
+        if (!has_b) {
+            lo = std::fmin(0.0, mul(a, g1).lo); // gamma^i decreases: the first tail term is the lowest
+        } else {
+            const Interval neg_part = add(mul(Interval(std::fmax(0.0, -a.lo)), s0), mul(Interval(std::fmax(0.0, -b.lo)), s1));
+            lo = std::fmin(0.0, -neg_part.hi);
+        }
+        return {lo, std::fmin(0.0, first.hi)};
+    }
+    case Op::SeriesMax: {
+        const Interval first = series_term_bound(a, b, has_b, g1, n + 1);
+        double hi;
+        if (!has_b) {
+            hi = std::fmax(0.0, mul(a, g1).hi);
+        } else {
+            const Interval pos_part = add(mul(Interval(std::fmax(0.0, a.hi)), s0), mul(Interval(std::fmax(0.0, b.hi)), s1));
+            hi = std::fmax(0.0, pos_part.hi);
+        }
+        return {std::fmax(0.0, first.lo), hi};
+    }
+    default: break;
+    }
+    throw std::logic_error("series_tail: not a series op");
+}
+
+Interval series_combine(Op kind, Interval acc, Interval term) {
+    switch (kind) {
+    case Op::SeriesSum: return add(acc, term);
+    case Op::SeriesMin: return min(acc, term);
+    case Op::SeriesMax: return max(acc, term);
+    default: break;
+    }
+    throw std::logic_error("series_combine: not a series op");
+}
+
+double series_combine_point(Op kind, double acc, double term) {
+    switch (kind) {
+    case Op::SeriesSum: return acc + term;
+    case Op::SeriesMin: return std::fmin(acc, term);
+    case Op::SeriesMax: return std::fmax(acc, term);
+    default: break;
+    }
+    throw std::logic_error("series_combine_point: not a series op");
+}
+
+} // namespace frac::ir

@@ -1,0 +1,224 @@
+#include "ir/tape.hpp"
+
+#include <bit>
+#include <fmt/format.h>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace frac::ir {
+
+namespace {
+
+int highest_level(std::uint64_t mask) { return mask == 0 ? 0 : 63 - std::countl_zero(mask); }
+
+class Scheduler {
+public:
+    Scheduler(const Graph& g, Tape& t) : g_(g), t_(t) {}
+
+    Slot run(NodeId root) {
+        t_.blocks.emplace_back();
+        contexts_.push_back({0, 0, {}});
+        return emit(root);
+    }
+
+private:
+    struct Context {
+        int level;
+        std::uint32_t block;
+        std::unordered_map<NodeId, Slot> memo;
+    };
+
+    Slot fresh() { return t_.num_slots++; }
+
+    Context& context_for(int level) {
+        for (auto it = contexts_.rbegin(); it != contexts_.rend(); ++it)
+            if (it->level == level) return *it;
+        throw std::logic_error(fmt::format("tape: index of level {} used outside its series", level));
+    }
+
+    Slot emit(NodeId id) {
+        const Node& n = g_[id];
+        if (n.op == Op::Const) {
+            auto [it, added] = const_slots_.try_emplace(id, no_slot);
+            if (added) {
+                it->second = fresh();
+                t_.constants.push_back({it->second, n.value, n.point});
+            }
+            return it->second;
+        }
+        if (n.op == Op::Var) {
+            if (n.imm < 0 || n.imm >= t_.inputs)
+                throw std::logic_error(fmt::format("tape: input {} out of range", n.imm));
+            Slot& s = t_.input_slots[static_cast<std::size_t>(n.imm)];
+            if (s == no_slot) s = fresh();
+            return s;
+        }
+        Context& ctx = context_for(highest_level(n.index_mask));
+        if (auto it = ctx.memo.find(id); it != ctx.memo.end()) return it->second;
+        if (n.op == Op::Index) {
+            // The index slot is allocated by the series that owns this context.
+            throw std::logic_error("tape: series index without its series");
+        }
+        Slot out = is_series(n.op) ? emit_series(id, ctx) : emit_op(id, ctx);
+        // emit_* may have grown contexts_ (invalidating ctx); look the context up again.
+        context_for(highest_level(n.index_mask)).memo[id] = out;
+        return out;
+    }
+
+    Slot emit_op(NodeId id, Context& ctx) {
+        const Node& n = g_[id];
+        const std::uint32_t block = ctx.block;
+        Instr ins;
+        ins.op = n.op;
+        ins.imm = n.imm;
+        for (int i = 0; i < arity(n.op); ++i) ins.in[static_cast<std::size_t>(i)] = emit(n.args[static_cast<std::size_t>(i)]);
+        ins.out = fresh();
+        t_.blocks[block].push_back(ins);
+        return ins.out;
+    }
+
+    Slot emit_series(NodeId id, Context& ctx) {
+        const Node& n = g_[id];
+        const std::uint32_t outer_block = ctx.block;
+        TapeSeries s;
+        s.kind = n.op;
+        s.data = n.series;
+        s.block = static_cast<std::uint32_t>(t_.blocks.size());
+        t_.blocks.emplace_back();
+        s.index_slot = fresh();
+        contexts_.push_back({n.series.level, s.block, {}});
+        contexts_.back().memo[find_index_node(n.series.level)] = s.index_slot;
+        s.body_slot = emit(n.args[0]);
+        contexts_.pop_back();
+        if (n.args[1] != no_node) s.tail_a = emit(n.args[1]);
+        if (n.args[2] != no_node) s.tail_b = emit(n.args[2]);
+        Instr ins;
+        ins.op = n.op;
+        ins.series = static_cast<std::uint32_t>(t_.series.size());
+        ins.out = fresh();
+        t_.series.push_back(s);
+        t_.blocks[outer_block].push_back(ins);
+        return ins.out;
+    }
+
+    NodeId find_index_node(int level) {
+        // Index nodes are few; a linear scan once per series keeps Graph free of a reverse map.
+        for (NodeId i = 0; i < g_.size(); ++i)
+            if (g_[i].op == Op::Index && g_[i].imm == level) return i;
+        return no_node;
+    }
+
+    const Graph& g_;
+    Tape& t_;
+    std::vector<Context> contexts_;
+    std::unordered_map<NodeId, Slot> const_slots_;
+};
+
+} // namespace
+
+std::size_t Tape::instruction_count() const {
+    std::size_t n = 0;
+    for (const auto& b : blocks) n += b.size();
+    return n;
+}
+
+Tape build_tape(const Graph& g, NodeId root, int inputs) {
+    Tape t;
+    t.inputs = inputs;
+    t.input_slots.assign(static_cast<std::size_t>(inputs), no_slot);
+    t.result = Scheduler(g, t).run(root);
+    return t;
+}
+
+namespace {
+
+std::string slot_name(Slot s) { return s == no_slot ? "-" : fmt::format("%{}", s); }
+
+std::string interval_text(Interval v) {
+    return v.is_thin() ? fmt::format("{}", v.lo) : fmt::format("[{}, {}]", v.lo, v.hi);
+}
+
+void print_block(const Tape& t, std::uint32_t b, int indent, std::string& out) {
+    const std::string pad(static_cast<std::size_t>(indent), ' ');
+    for (const Instr& ins : t.blocks[b]) {
+        if (is_series(ins.op)) {
+            const TapeSeries& s = t.series[ins.series];
+            const std::string end = s.data.end == infinite_end ? "inf" : fmt::format("{}", s.data.end);
+            out += fmt::format("{}{} = {} {} in {}..{} {{\n", pad, slot_name(ins.out), op_name(ins.op),
+                               slot_name(s.index_slot), s.data.start, end);
+            print_block(t, s.block, indent + 2, out);
+            out += fmt::format("{}}} term {}", pad, slot_name(s.body_slot));
+            if (s.data.end == infinite_end)
+                out += fmt::format(" tail ({} + {} i) * {}^i", slot_name(s.tail_a), slot_name(s.tail_b),
+                                   interval_text(s.data.gamma));
+            out += "\n";
+            continue;
+        }
+        out += fmt::format("{}{} = {}", pad, slot_name(ins.out), op_name(ins.op));
+        for (int i = 0; i < arity(ins.op); ++i) out += fmt::format("{} {}", i ? "," : "", slot_name(ins.in[static_cast<std::size_t>(i)]));
+        if (ins.op == Op::PowI) out += fmt::format(", {}", ins.imm);
+        out += "\n";
+    }
+}
+
+} // namespace
+
+std::string print_tape(const Tape& t) {
+    std::string out = fmt::format("tape: {} inputs, {} slots, {} instructions\n", t.inputs, t.num_slots,
+                                  t.instruction_count());
+    for (std::size_t k = 0; k < t.input_slots.size(); ++k)
+        if (t.input_slots[k] != no_slot) out += fmt::format("{} = input {}\n", slot_name(t.input_slots[k]), k);
+    for (const TapeConst& c : t.constants) out += fmt::format("{} = const {}\n", slot_name(c.slot), interval_text(c.value));
+    print_block(t, 0, 0, out);
+    out += fmt::format("result {}\n", slot_name(t.result));
+    return out;
+}
+
+namespace {
+
+std::string verify_block(const Tape& t, std::uint32_t b, std::vector<bool>& written) {
+    for (const Instr& ins : t.blocks[b]) {
+        const int k = is_series(ins.op) ? 0 : arity(ins.op);
+        for (int i = 0; i < k; ++i) {
+            const Slot s = ins.in[static_cast<std::size_t>(i)];
+            if (s >= t.num_slots || !written[s])
+                return fmt::format("block {}: {} reads {} before it is written", b, op_name(ins.op), slot_name(s));
+        }
+        if (is_series(ins.op)) {
+            if (ins.series >= t.series.size()) return fmt::format("block {}: bad series index", b);
+            const TapeSeries& s = t.series[ins.series];
+            if (s.block <= b || s.block >= t.blocks.size()) return fmt::format("series block {} out of order", s.block);
+            if (s.index_slot >= t.num_slots) return "series index slot out of range";
+            written[s.index_slot] = true;
+            if (auto e = verify_block(t, s.block, written); !e.empty()) return e;
+            if (s.body_slot >= t.num_slots || !written[s.body_slot]) return "series term slot not written";
+            if (s.data.end == infinite_end) {
+                if (s.tail_a == no_slot || !written[s.tail_a]) return "infinite series without tail coefficient";
+                if (s.tail_b != no_slot && !written[s.tail_b]) return "series tail coefficient not written";
+                if (!(s.data.gamma.lo > 0 && s.data.gamma.hi < 1)) return "infinite series without decay in (0, 1)";
+            }
+        }
+        if (ins.out >= t.num_slots || written[ins.out])
+            return fmt::format("block {}: slot {} written twice or out of range", b, slot_name(ins.out));
+        written[ins.out] = true;
+    }
+    return {};
+}
+
+} // namespace
+
+std::string verify_tape(const Tape& t) {
+    if (t.blocks.empty()) return "tape without main block";
+    std::vector<bool> written(t.num_slots, false);
+    for (const TapeConst& c : t.constants) {
+        if (c.slot >= t.num_slots) return "constant slot out of range";
+        written[c.slot] = true;
+    }
+    for (Slot s : t.input_slots)
+        if (s != no_slot) written[s] = true;
+    if (auto e = verify_block(t, 0, written); !e.empty()) return e;
+    if (t.result >= t.num_slots || !written[t.result]) return "result slot not written";
+    return {};
+}
+
+} // namespace frac::ir

@@ -1,0 +1,38 @@
+// Structural checks of the expression graph; a failure is an internal error, never a user error.
+#include "ir/graph.hpp"
+
+#include <fmt/format.h>
+
+namespace frac::ir {
+
+std::string verify_graph(const Graph& g) {
+    for (NodeId id = 0; id < g.size(); ++id) {
+        const Node& n = g[id];
+        const int want = is_series(n.op) ? 1 : arity(n.op);
+        for (int i = 0; i < 3; ++i) {
+            const NodeId a = n.args[static_cast<std::size_t>(i)];
+            if (i < want && a == no_node) return fmt::format("%{}: {} lacks argument {}", id, op_name(n.op), i);
+            if (!is_series(n.op) && i >= want && a != no_node)
+                return fmt::format("%{}: {} has too many arguments", id, op_name(n.op));
+            if (a != no_node && a >= id) return fmt::format("%{}: argument %{} is not earlier", id, a);
+        }
+        if (n.op == Op::Index && (n.imm < 1 || n.imm > 63)) return fmt::format("%{}: bad index level", id);
+        if (is_series(n.op)) {
+            const SeriesData& s = n.series;
+            if (s.level < 1) return fmt::format("%{}: series without level", id);
+            if (s.end != infinite_end && s.end < s.start) return fmt::format("%{}: empty series range", id);
+            if (s.end == infinite_end) {
+                if (n.args[1] == no_node) return fmt::format("%{}: infinite series without tail", id);
+                if (!(s.gamma.lo > 0 && s.gamma.hi < 1)) return fmt::format("%{}: decay not in (0, 1)", id);
+                for (int i = 1; i < 3; ++i) {
+                    const NodeId a = n.args[static_cast<std::size_t>(i)];
+                    if (a != no_node && (g[a].index_mask >> s.level) & 1)
+                        return fmt::format("%{}: tail coefficient depends on the series index", id);
+                }
+            }
+        }
+    }
+    return {};
+}
+
+} // namespace frac::ir

@@ -1,0 +1,86 @@
+// Recursive space subdivision (RSS, paper sec. 2.2): classify boxes as inside (f < 0 on the whole
+// box), outside (f > 0) or undecided, subdividing undecided boxes down to a depth limit. The
+// undecided boxes at the deepest level form the cover of the boundary.
+//
+// Classification of a cell from the enclosure [lo, hi] of f over its box:
+//  - hi < 0                      -> inside   (f < 0 everywhere on the box)
+//  - lo > 0                      -> outside  (f > 0 everywhere on the box)
+//  - empty enclosure (lo > hi)   -> outside: f is undefined on the whole box (e.g. sqrt of a
+//                                   negative number), so no point of the box satisfies f < 0 or
+//                                   f = 0, and the box holds neither the shape nor its boundary.
+//  - anything else, including a NaN bound (which the numeric core never produces, but a backend
+//    might) -> undecided: subdivided below `depth`, a `boundary` cell at `depth`. Undecided is
+//    always the safe answer: the cover may be too large, never too small.
+//
+// The root is level 0; level k has split^k cells per axis. Cells are evaluated level by level
+// (breadth first) through the batch API Evaluator::eval_boxes.
+#pragma once
+
+#include "ir/evaluator.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace frac::rt {
+
+using num::Interval;
+
+enum class CellClass : std::uint8_t { inside, outside, boundary, subdivided };
+
+// A cell of the subdivision: level k, integer position ix, iy (and iz) in the 2^k (or split^k) grid.
+struct Cell {
+    std::uint8_t level = 0;
+    CellClass cls = CellClass::boundary;
+    std::uint32_t ix = 0, iy = 0, iz = 0;
+};
+
+// Called after each completed level and, during a long level, after a batch when at least a second
+// has passed since the previous call. `level` is the level being evaluated, `evaluated` the number
+// of cells evaluated so far over all levels.
+using RssProgress = std::function<void(int level, std::uint64_t evaluated)>;
+
+struct RssOptions {
+    int depth = 8;            // levels of subdivision below the root box
+    int split = 2;            // parts per axis and level
+    bool keep_cells = true;   // record every evaluated cell (for pictures); false keeps only counts
+    std::size_t batch = 4096; // cells per eval_boxes call (>= 1)
+    RssProgress progress;     // optional
+};
+
+// Hard limits, reported as errors when exceeded. Besides, split^depth must not exceed 2^32 (cell
+// positions are 32-bit): with split 3 the depth is at most 20, with split 4 at most 16.
+inline constexpr int max_depth_2d = 24;
+inline constexpr int max_depth_3d = 14;
+
+struct LevelCounts {
+    std::uint64_t evaluated = 0, inside = 0, outside = 0, undecided = 0;
+};
+
+struct RssResult {
+    std::vector<Interval> root; // the root box, one interval per axis
+    RssOptions options;
+    // Every evaluated cell, when keep_cells: ordered by level, then within a level by position
+    // (iz, then iy, then ix: row-major, x fastest).
+    std::vector<Cell> cells;
+    std::vector<LevelCounts> levels; // index = level, 0..depth
+    // Totals over all levels; evaluated = inside + outside + boundary + subdivided.
+    std::uint64_t evaluated = 0, inside = 0, outside = 0, boundary = 0, subdivided = 0;
+    double seconds = 0; // wall time of subdivide (steady clock)
+
+    // Outward enclosure of a cell's box along `axis`: lo = RD(x0 + (x1-x0)*i/n),
+    // hi = RU(x0 + (x1-x0)*(i+1)/n), n = split^level, clamped to the root box. Neighbouring cells
+    // overlap (or touch) rather than leave gaps. Sets upward rounding itself.
+    Interval cell_interval(const Cell& c, int axis) const;
+    // Number of axes (2 or 3).
+    int dimension() const { return static_cast<int>(root.size()); }
+    // split^level: the number of cells per axis at `level`.
+    std::uint64_t cells_per_axis(int level) const;
+};
+
+// Throws std::invalid_argument on a bad depth/split/batch or a box of the wrong dimension (the
+// root must have 2 or 3 axes, as many as f.dimension(), each finite with lo < hi).
+RssResult subdivide(ir::Evaluator& f, const std::vector<Interval>& root, const RssOptions& options);
+
+} // namespace frac::rt
