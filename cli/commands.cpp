@@ -16,7 +16,7 @@ int run_check(const std::string& file, const std::string& emit, const std::strin
     auto c = compile_or_report(file, stop);
     if (!c) return front::exit_compile_error;
     if (emit == "ast") {
-        std::cout << front::print_ast(c->program);
+        std::cout << front::print_ast(c->program, 1); // the file itself, not its imports
         return 0;
     }
     const front::Module& m = c->module;

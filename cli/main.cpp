@@ -62,7 +62,8 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        const int code = app.exit(e);
+        return code == 0 ? 0 : 64; // EX_USAGE for every malformed command line
     }
     try {
         if (*check) return cli::run_check(file, emit, shape);

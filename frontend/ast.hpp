@@ -82,7 +82,8 @@ struct Program {
 Program parse(const std::vector<Token>& tokens, Diagnostics& diags);
 
 // Text form of the syntax tree (frac check --emit=ast).
-std::string print_ast(const Program& p);
+// Only the items of `file` when it is not 0 (imported files' items are left out).
+std::string print_ast(const Program& p, std::uint32_t file = 0);
 std::string print_expr(const Expr& e);
 
 } // namespace frac::front

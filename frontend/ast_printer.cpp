@@ -64,9 +64,10 @@ std::string print_expr(const Expr& e) {
     return "?";
 }
 
-std::string print_ast(const Program& p) {
+std::string print_ast(const Program& p, std::uint32_t file) {
     std::string out;
     for (const Item& it : p.items) {
+        if (file != 0 && it.loc.file != file) continue;
         std::string params;
         for (std::size_t i = 0; i < it.params.size(); ++i) params += (i ? " " : "") + it.params[i].name;
         switch (it.kind) {

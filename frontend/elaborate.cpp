@@ -66,12 +66,16 @@ public:
     }
 
 private:
+    // Thrown when a definition used here failed to compile: its error is already reported.
+    struct AlreadyReported {};
+
     template <class F>
     void guarded(F&& f) {
         try {
             f();
         } catch (const CompileError& e) {
             d_.error(e.loc, e.what());
+        } catch (const AlreadyReported&) {
         }
     }
 
@@ -80,10 +84,20 @@ private:
     // ---- items ----
     std::size_t shape_info(const Item& it) {
         if (auto done = shape_index_.find(&it); done != shape_index_.end()) {
+            if (done->second == failed) throw AlreadyReported{};
             if (done->second == in_progress) fail(it.loc, fmt::format("shape '{}' is defined in terms of itself", it.name));
             return done->second;
         }
         shape_index_[&it] = in_progress;
+        try {
+            return build_shape(it);
+        } catch (...) {
+            shape_index_[&it] = failed;
+            throw;
+        }
+    }
+
+    std::size_t build_shape(const Item& it) {
         ShapeInfo info;
         info.name = it.name;
         info.loc = it.loc;
@@ -129,7 +143,7 @@ private:
     }
 
     Value const_value(const Item& it, Location use) {
-        if (failed_consts_.count(&it)) fail(use, fmt::format("constant '{}' has errors", it.name));
+        if (failed_consts_.count(&it)) throw AlreadyReported{};
         if (auto c = consts_.find(&it); c != consts_.end()) {
             if (!c->second) fail(use, fmt::format("constant '{}' is defined in terms of itself", it.name));
             return *c->second;
@@ -139,7 +153,7 @@ private:
             const Value v = closed(*it.body, Context::constant);
             consts_[&it] = v;
             return v;
-        } catch (const CompileError&) {
+        } catch (...) {
             consts_.erase(&it);
             failed_consts_.insert(&it);
             throw;
@@ -518,7 +532,7 @@ private:
     }
 
     Value series(const Expr& e) {
-        Frame& f = frames_.back();
+        const std::size_t frame = frames_.size() - 1; // frames_ grows while the body is elaborated
         auto integer = [&](const Expr& x, const char* what) {
             const NodeId n = scalar(expr(x), x.loc);
             std::int64_t v = 0;
@@ -537,18 +551,19 @@ private:
         } else if (data.start < 0) {
             fail(e.kids[0]->loc, "an infinite series must start at an index >= 0");
         }
-        if (f.level + 1 > limits_.max_series_nesting)
+        if (frames_[frame].level + 1 > limits_.max_series_nesting)
             fail(e.loc, fmt::format("series nested deeper than the limit of {}", limits_.max_series_nesting));
-        data.level = ++f.level;
-        f.scopes.emplace_back();
-        f.scopes.back().emplace_back(e.var, Value::scalar(g_.index(data.level)));
+        data.level = ++frames_[frame].level;
+        frames_[frame].scopes.emplace_back();
+        frames_[frame].scopes.back().emplace_back(e.var, Value::scalar(g_.index(data.level)));
         struct Restore {
-            Frame& f;
+            std::vector<Frame>& frames;
+            std::size_t frame;
             ~Restore() {
-                f.scopes.pop_back();
-                --f.level;
+                frames[frame].scopes.pop_back();
+                --frames[frame].level;
             }
-        } restore{f};
+        } restore{frames_, frame};
         const NodeId body = scalar(expr(*e.kids[2]), e.kids[2]->loc);
         const Op kind = e.text == "sum" ? Op::SeriesSum : e.text == "min" ? Op::SeriesMin : Op::SeriesMax;
         if (!infinite) return Value::scalar(g_.series(kind, data, body, ir::no_node, ir::no_node));
@@ -570,6 +585,7 @@ private:
     };
 
     static constexpr std::size_t in_progress = static_cast<std::size_t>(-1);
+    static constexpr std::size_t failed = static_cast<std::size_t>(-2);
     const Program& p_;
     const SourceManager& sm_;
     Limits limits_;

@@ -112,10 +112,10 @@ private:
             ++stats.series_terms;
             if (i == last) break;
             if (infinite) {
-                // Stop when this term told no more than its static bound: the box is too wide for
-                // later terms to resolve anything.
+                // Stop when this term told little more than its static bound: the box is too wide
+                // for later terms to resolve anything. (The factor absorbs the rounding of gamma^i.)
                 const Interval bound = ir::series_term_bound(a, b, has_b, gamma_i, i);
-                if (num::width(term) >= num::width(bound)) {
+                if (num::width(term) >= 0.75 * num::width(bound)) {
                     resolved = true;
                     break;
                 }

@@ -1,0 +1,95 @@
+#include "frontend/ast.hpp"
+#include "frontend/driver.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace frac::front;
+
+namespace {
+
+std::string ast_of(const std::string& text, std::string* errors = nullptr) {
+    auto c = compile_source("t.frac", text, {}, StopAfter::parse);
+    if (errors) *errors = c->diags.render(c->sources);
+    else if (!c->ok()) FAIL(c->diags.render(c->sources));
+    return print_ast(c->program, 1);
+}
+
+} // namespace
+
+// One example of every production of grammar/frac.ebnf.
+TEST_CASE("every grammar production parses", "[grammar]") {
+    struct Case {
+        const char* production;
+        const char* source;
+        const char* ast;
+    };
+    const Case cases[] = {
+        {"import", "import \"fractals\";", "(import \"fractals\")\n"},
+        {"function/params", "fn f(a, b) = a;", "(fn f (a b) a)\n"},
+        {"function without params", "fn k() = 1;", "(fn k () 1)\n"},
+        {"constant", "const c = 2;", "(const c 2)\n"},
+        {"shape", "shape s(x, y) over [0, 1] × [0, 2] = x;",
+         "(shape s (x y) (over (× (interval 0 1) (interval 0 2))) x)\n"},
+        {"shape without params", "shape s = x;", "(shape s () x)\n"},
+        {"test/expectation", "test \"t\" { expect 1 < 2; expect 1 == 1 within 0.1; }",
+         "(test \"t\"\n  (expect (< 1 2))\n  (expect (== 1 1) (within 0.1)))\n"},
+        {"print", "print 1;", "(print 1)\n"},
+        {"let/binding", "const c = let a = 1, b = a in b;", "(const c (let ((a 1) (b a)) b))\n"},
+        {"if", "const c = if 1 < 2 then 3 else 4;", "(const c (if (< 1 2) 3 4))\n"},
+        {"or/and/not", "const c = not 1 < 2 and 2 < 3 or 1 == 1;",
+         "(const c (or (and (not (< 1 2)) (< 2 3)) (== 1 1)))\n"},
+        {"comparison ops", "const c = 1 <= 2 and 2 != 0 and 1 >= 0 and 2 > 1 and 0 == 0;", ""},
+        {"union/intersection", "const c = 1 | 2 & 3;", "(const c (| 1 (& 2 3)))\n"},
+        {"box", "const c = [0, 1] × [2, 3] × [4, 5];", "(const c (× (× (interval 0 1) (interval 2 3)) (interval 4 5)))\n"},
+        {"sum/product", "const c = 1 + 2 * 3 - 4 / 5;", "(const c (- (+ 1 (* 2 3)) (/ 4 5)))\n"},
+        {"unary", "const c = -~+1;", "(const c (- (~ (+ 1))))\n"},
+        {"power", "const c = -2^3^-1;", "(const c (- (^ 2 (^ 3 (- 1)))))\n"},
+        {"postfix", "const c = (1, 2).y;", "(const c (. y (point 1 2)))\n"},
+        {"primary: number forms", "const c = 1.5e-3 + .5 + 2.;", "(const c (+ (+ 1.5e-3 .5) 2.))\n"},
+        {"primary: parenthesis", "const c = (1 + 2) * 3;", "(const c (* (+ 1 2) 3))\n"},
+        {"primary: point", "const c = (1, 2, 3);", "(const c (point 1 2 3))\n"},
+        {"primary: interval", "const c = [1, 2];", "(const c (interval 1 2))\n"},
+        {"call/argument", "const c = dimension(s, from: 4, to: 9);", "(const c (call dimension s from: 4 to: 9))\n"},
+        {"series infinite", "fn f(x) = sum(i in 0.., x / 2^i);", "(fn f (x) (sum i 0 inf (/ x (^ 2 i))))\n"},
+        {"series finite", "fn f(x) = min(k in 1..5, x);", "(fn f (x) (min k 1 5 x))\n"},
+        {"max call is not a series", "fn f(x) = max(x, 1);", "(fn f (x) (call max x 1))\n"},
+        {"comments", "// line\n/* block */ const c = 1; // end", "(const c 1)\n"},
+    };
+    for (const Case& c : cases) {
+        INFO(c.production);
+        const std::string got = ast_of(c.source);
+        if (*c.ast) CHECK(got == c.ast);
+    }
+}
+
+TEST_CASE("ranges are not numbers: 0..5", "[lexer]") {
+    CHECK(ast_of("fn f(x) = sum(i in 0..5, x);") == "(fn f (x) (sum i 0 5 x))\n");
+}
+
+TEST_CASE("syntax errors are located and the parser recovers", "[parser]") {
+    std::string errors;
+    ast_of("fn f(x) = x +;\nshape s(x, y) = (x;\nconst ok = 1;\nconst c = 1 < 2 < 3;\n", &errors);
+    CHECK(errors.find("t.frac:1:14: error: expected an expression, found ';'") != std::string::npos);
+    CHECK(errors.find("t.frac:2:19: error: expected ')' to close the parenthesis, found ';'") != std::string::npos);
+    CHECK(errors.find("t.frac:4:17: error: comparisons do not chain") != std::string::npos);
+    // The source line and a caret under the column.
+    CHECK(errors.find("  fn f(x) = x +;\n               ^\n") != std::string::npos);
+}
+
+TEST_CASE("deeply nested input is an error, not a stack overflow", "[parser][limits]") {
+    std::string deep = "const c = " + std::string(100000, '(') + "1" + std::string(100000, ')') + ";";
+    std::string errors;
+    ast_of(deep, &errors);
+    CHECK(errors.find("nested deeper than") != std::string::npos);
+    std::string minus = "const c = " + std::string(100000, '-') + "1;";
+    ast_of(minus, &errors);
+    CHECK(errors.find("nested deeper than") != std::string::npos);
+}
+
+TEST_CASE("the unicode box operator is a token", "[lexer]") {
+    Diagnostics d;
+    const auto toks = lex("[0,1] × [0,1]", 1, d);
+    REQUIRE_FALSE(d.has_errors());
+    CHECK(toks[5].kind == Tok::times);
+    CHECK(toks[6].loc.column == 9); // columns count characters, not bytes
+}
