@@ -49,14 +49,16 @@ private:
     }
 
     // Brings two forms to a common decay, or fails.
-    void align(TermBound& x, TermBound& y, const char* what) {
+    void align(TermBound& x, TermBound& y) {
         if (same(x.gamma, y.gamma)) return;
         if (x.gamma.hi <= y.gamma.lo) {
             x = slow_down(x, y.gamma);
         } else if (y.gamma.hi <= x.gamma.lo) {
             y = slow_down(y, x.gamma);
         } else {
-            throw Failure{fmt::format("the operands of {} decay at rates that cannot be ordered", what)};
+            // Overlapping enclosures of (nearly) the same decay: each true decay lies in the hull.
+            const Interval both = num::hull(x.gamma, y.gamma);
+            x.gamma = y.gamma = both;
         }
     }
 
@@ -79,7 +81,7 @@ private:
         case Op::Add:
         case Op::Sub: {
             TermBound x = arg(0), y = arg(1);
-            align(x, y, n.op == Op::Add ? "'+'" : "'-'");
+            align(x, y);
             TermBound r;
             r.gamma = x.gamma;
             r.a = g_.op(n.op, x.a, y.a);
@@ -174,7 +176,7 @@ private:
             // Each result is one of the operands: the hull of their forms bounds it.
             const int first = n.op == Op::Select ? 1 : 0;
             TermBound x = arg(first), y = arg(first + 1);
-            align(x, y, n.op == Op::Select ? "if" : ir::op_name(n.op));
+            align(x, y);
             TermBound r;
             r.gamma = x.gamma;
             r.a = hull(x.a, y.a);

@@ -17,6 +17,9 @@ using num::Interval;
 struct EvalOptions {
     // Most terms summed of an infinite series before its tail bound takes over (sound either way).
     int max_terms = 128;
+    // Stop a series when the box is too wide for further terms to resolve anything (see
+    // docs/design.md). Off: sum until the tail is negligible or max_terms (for measurements).
+    bool adaptive_terms = true;
 };
 inline constexpr int max_terms_limit = 100000;
 

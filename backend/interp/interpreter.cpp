@@ -115,7 +115,7 @@ private:
                 // Stop when this term told little more than its static bound: the box is too wide
                 // for later terms to resolve anything. (The factor absorbs the rounding of gamma^i.)
                 const Interval bound = ir::series_term_bound(a, b, has_b, gamma_i, i);
-                if (num::width(term) >= 0.75 * num::width(bound)) {
+                if (options_.adaptive_terms && num::width(term) >= 0.75 * num::width(bound)) {
                     resolved = true;
                     break;
                 }

@@ -1,0 +1,255 @@
+#include "runtime/rss.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+namespace frac::rt {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Position of a cell in the grid of its level.
+struct Pos {
+    std::uint32_t ix, iy, iz;
+};
+
+// split^k; exact in 64 bits (and as a double) for split <= 4, k <= 24.
+std::uint64_t ipow(int split, int k) {
+    std::uint64_t n = 1;
+    for (int i = 0; i < k; ++i) n *= static_cast<std::uint64_t>(split);
+    return n;
+}
+
+// Enclosure of the grid point x0 + w * j / n of an axis, w enclosing x1 - x0. Requires upward
+// rounding. j and n are below 2^53, hence exact doubles.
+Interval grid_point(Interval axis, Interval w, std::uint64_t j, std::uint64_t n) {
+    const Interval t =
+        num::div(num::mul(w, Interval(static_cast<double>(j))), Interval(static_cast<double>(n)));
+    return num::add(Interval(axis.lo), t);
+}
+
+// Outward box of cell i of n along an axis. Requires upward rounding. The end points shared by
+// neighbours are computed by the same expression, so hi(cell i) >= lo(cell i+1): no gaps. Clamping
+// to the root keeps the enclosure (the exact grid points lie in the root) and makes the outer
+// cells end exactly on the root's bounds.
+Interval cell_axis(Interval axis, Interval w, std::uint64_t i, std::uint64_t n) {
+    const double lo = i == 0 ? axis.lo : std::max(axis.lo, grid_point(axis, w, i, n).lo);
+    const double hi = i + 1 >= n ? axis.hi : std::min(axis.hi, grid_point(axis, w, i + 1, n).hi);
+    return {lo, hi};
+}
+
+// Enclosure of the root's width along each axis. Requires upward rounding.
+Interval axis_width(Interval axis) {
+    return num::sub(Interval(axis.hi), Interval(axis.lo));
+}
+
+enum class Verdict { inside, outside, undecided };
+
+// See the header for the rules. The NaN test comes first because an interval with a NaN bound
+// also looks "empty" (!(lo <= hi)), and a NaN says nothing about the box.
+Verdict classify(Interval z) {
+    if (std::isnan(z.lo) || std::isnan(z.hi)) return Verdict::undecided;
+    if (z.lo > z.hi) return Verdict::outside; // empty: f undefined on the whole box
+    if (z.hi < 0) return Verdict::inside;
+    if (z.lo > 0) return Verdict::outside;
+    return Verdict::undecided;
+}
+
+void validate(const ir::Evaluator& f, const std::vector<Interval>& root, const RssOptions& o) {
+    const int d = static_cast<int>(root.size());
+    if (d != 2 && d != 3)
+        throw std::invalid_argument(fmt::format("subdivide: the root box has {} axes; it needs 2 or 3", d));
+    if (f.dimension() != d)
+        throw std::invalid_argument(fmt::format(
+            "subdivide: the shape takes {} coordinates but the root box has {} axes", f.dimension(), d));
+    for (int a = 0; a < d; ++a) {
+        const Interval x = root[static_cast<std::size_t>(a)];
+        if (!(std::isfinite(x.lo) && std::isfinite(x.hi) && x.lo < x.hi))
+            throw std::invalid_argument(fmt::format(
+                "subdivide: root axis {} is [{}, {}]; it needs finite bounds with lo < hi", a, x.lo, x.hi));
+    }
+    if (o.split < 2 || o.split > 4)
+        throw std::invalid_argument(fmt::format("subdivide: split {} is out of range [2, 4]", o.split));
+    const int max_depth = d == 2 ? max_depth_2d : max_depth_3d;
+    if (o.depth < 0 || o.depth > max_depth)
+        throw std::invalid_argument(
+            fmt::format("subdivide: depth {} is out of range [0, {}] in {}D", o.depth, max_depth, d));
+    if (ipow(o.split, o.depth) > (std::uint64_t{1} << 32))
+        throw std::invalid_argument(fmt::format(
+            "subdivide: split^depth = {}^{} exceeds 2^32 cells per axis (cell positions are 32-bit)", o.split,
+            o.depth));
+    if (o.batch == 0) throw std::invalid_argument("subdivide: batch must be at least 1");
+}
+
+// One run of the subdivision. Holds the frontier of the current level (its undecided cells) and
+// the batch being filled, nothing else unless keep_cells.
+class Runner {
+  public:
+    Runner(ir::Evaluator& f, RssResult& r) : f_(f), r_(r), d_(r.dimension()) {
+        num::UpwardRounding up;
+        for (const Interval& x : r_.root) width_.push_back(axis_width(x));
+        queue_.reserve(std::min<std::size_t>(r_.options.batch, 1 << 16));
+    }
+
+    void run() {
+        const int depth = r_.options.depth;
+        r_.levels.assign(static_cast<std::size_t>(depth) + 1, LevelCounts{});
+        last_progress_ = Clock::now();
+
+        start_level(0);
+        push({0, 0, 0});
+        finish_level();
+        for (int k = 1; k <= depth; ++k) {
+            std::vector<Pos> parents;
+            parents.swap(next_);
+            start_level(k);
+            push_children(parents);
+            finish_level();
+        }
+        for (const LevelCounts& lc : r_.levels) {
+            r_.inside += lc.inside;
+            r_.outside += lc.outside;
+        }
+        r_.boundary = r_.levels[static_cast<std::size_t>(depth)].undecided;
+        r_.subdivided = r_.evaluated - r_.inside - r_.outside - r_.boundary;
+    }
+
+  private:
+    void start_level(int k) {
+        level_ = k;
+        n_ = ipow(r_.options.split, k);
+    }
+
+    void finish_level() {
+        flush();
+        if (r_.options.progress) r_.options.progress(level_, r_.evaluated);
+        last_progress_ = Clock::now();
+    }
+
+    // Children of `parents` (the undecided cells of the previous level, row-major) in row-major
+    // order: the children of one parent row fill `split` child rows, each running over all the
+    // parents of the row; likewise for slabs of constant iz in 3D. Linear time, no sort.
+    void push_children(const std::vector<Pos>& parents) {
+        const auto s = static_cast<std::uint32_t>(r_.options.split);
+        const std::uint32_t sz = d_ == 3 ? s : 1;
+        for (std::size_t slab = 0; slab < parents.size();) {
+            std::size_t slab_end = slab;
+            while (slab_end < parents.size() && parents[slab_end].iz == parents[slab].iz) ++slab_end;
+            for (std::uint32_t cz = 0; cz < sz; ++cz) {
+                for (std::size_t row = slab; row < slab_end;) {
+                    std::size_t row_end = row;
+                    while (row_end < slab_end && parents[row_end].iy == parents[row].iy) ++row_end;
+                    for (std::uint32_t cy = 0; cy < s; ++cy)
+                        for (std::size_t p = row; p < row_end; ++p)
+                            for (std::uint32_t cx = 0; cx < s; ++cx)
+                                push({parents[p].ix * s + cx, parents[p].iy * s + cy,
+                                      parents[p].iz * sz + cz});
+                    row = row_end;
+                }
+            }
+            slab = slab_end;
+        }
+    }
+
+    void push(Pos p) {
+        queue_.push_back(p);
+        if (queue_.size() >= r_.options.batch) flush();
+    }
+
+    // Evaluates the queued cells of the current level in one eval_boxes call and classifies them.
+    void flush() {
+        const std::size_t m = queue_.size();
+        if (m == 0) return;
+        const auto d = static_cast<std::size_t>(d_);
+        boxes_.resize(m * d);
+        out_.resize(m);
+        {
+            num::UpwardRounding up; // the cell boxes use the numeric core's directed rounding
+            for (std::size_t j = 0; j < m; ++j) {
+                const std::uint32_t pos[3] = {queue_[j].ix, queue_[j].iy, queue_[j].iz};
+                for (std::size_t a = 0; a < d; ++a)
+                    boxes_[j * d + a] = cell_axis(r_.root[a], width_[a], pos[a], n_);
+            }
+        }
+        f_.eval_boxes(boxes_.data(), m, out_.data());
+
+        const bool last = level_ == r_.options.depth;
+        LevelCounts& lc = r_.levels[static_cast<std::size_t>(level_)];
+        for (std::size_t j = 0; j < m; ++j) {
+            CellClass cls = CellClass::boundary;
+            switch (classify(out_[j])) {
+            case Verdict::inside:
+                cls = CellClass::inside;
+                ++lc.inside;
+                break;
+            case Verdict::outside:
+                cls = CellClass::outside;
+                ++lc.outside;
+                break;
+            case Verdict::undecided:
+                ++lc.undecided;
+                if (!last) {
+                    cls = CellClass::subdivided;
+                    next_.push_back(queue_[j]);
+                }
+                break;
+            }
+            if (r_.options.keep_cells)
+                r_.cells.push_back(
+                    {static_cast<std::uint8_t>(level_), cls, queue_[j].ix, queue_[j].iy, queue_[j].iz});
+        }
+        lc.evaluated += m;
+        r_.evaluated += m;
+        queue_.clear();
+
+        if (r_.options.progress && Clock::now() - last_progress_ >= std::chrono::seconds(1)) {
+            r_.options.progress(level_, r_.evaluated);
+            last_progress_ = Clock::now();
+        }
+    }
+
+    ir::Evaluator& f_;
+    RssResult& r_;
+    int d_;
+    int level_ = 0;
+    std::uint64_t n_ = 1;               // cells per axis at level_
+    std::vector<Interval> width_;       // enclosure of the root's width per axis
+    std::vector<Pos> queue_;            // cells of level_ waiting for evaluation
+    std::vector<Interval> boxes_, out_; // batch buffers
+    std::vector<Pos> next_;             // undecided cells of level_, row-major
+    Clock::time_point last_progress_;
+};
+
+} // namespace
+
+std::uint64_t RssResult::cells_per_axis(int level) const {
+    return ipow(options.split, level);
+}
+
+Interval RssResult::cell_interval(const Cell& c, int axis) const {
+    if (axis < 0 || axis >= dimension())
+        throw std::out_of_range(fmt::format("cell_interval: axis {} of a {}D box", axis, dimension()));
+    const std::uint32_t i = axis == 0 ? c.ix : axis == 1 ? c.iy : c.iz;
+    const Interval x = root[static_cast<std::size_t>(axis)];
+    num::UpwardRounding up;
+    return cell_axis(x, axis_width(x), i, cells_per_axis(c.level));
+}
+
+RssResult subdivide(ir::Evaluator& f, const std::vector<Interval>& root, const RssOptions& options) {
+    validate(f, root, options);
+    const auto start = Clock::now();
+    RssResult r;
+    r.root = root;
+    r.options = options;
+    Runner(f, r).run();
+    r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    return r;
+}
+
+} // namespace frac::rt
