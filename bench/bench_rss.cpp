@@ -49,8 +49,8 @@ int main(int argc, char** argv) {
         return 1;
     }
     std::vector<Row> rows;
-    fmt::print("{:<18} {:>6} {:>10} {:>12} {:>12} {:>10} {:>14}\n", "shape", "depth", "boxes", "boxes/s", "terms/box",
-               "seconds", "fixed/adaptive");
+    fmt::print("{:<18} {:>6} {:>10} {:>12} {:>12} {:>10} {:>14}\n", "shape", "depth", "boxes", "boxes/s",
+               "terms/box", "seconds", "fixed/adaptive");
     for (const front::ShapeInfo& s : c->module.shapes) {
         ir::EvalOptions adaptive, fixed;
         fixed.adaptive_terms = false;
@@ -65,10 +65,11 @@ int main(int argc, char** argv) {
     json << "[\n";
     for (std::size_t i = 0; i < rows.size(); ++i) {
         const Row& r = rows[i];
-        json << fmt::format("  {{\"shape\": \"{}\", \"variant\": \"{}\", \"engine\": \"interp\", \"depth\": {}, "
-                            "\"boxes\": {}, \"series_terms\": {}, \"seconds\": {}, \"boxes_per_second\": {}}}{}\n",
-                            r.shape, r.variant, r.depth, r.boxes, r.terms, r.seconds, r.boxes / r.seconds,
-                            i + 1 < rows.size() ? "," : "");
+        json << fmt::format(
+            "  {{\"shape\": \"{}\", \"variant\": \"{}\", \"engine\": \"interp\", \"depth\": {}, "
+            "\"boxes\": {}, \"series_terms\": {}, \"seconds\": {}, \"boxes_per_second\": {}}}{}\n",
+            r.shape, r.variant, r.depth, r.boxes, r.terms, r.seconds, r.boxes / r.seconds,
+            i + 1 < rows.size() ? "," : "");
     }
     json << "]\n";
     fmt::print("wrote {}\n", json_path);

@@ -27,9 +27,11 @@ int run_check(const std::string& file, const std::string& emit, const std::strin
         for (const auto& s : m.shapes) shapes.push_back(&s);
     for (const front::ShapeInfo* s : shapes) {
         if (emit == "ir") {
-            std::cout << fmt::format("shape {} ({} coordinates):\n{}", s->name, s->dimension, ir::print_graph(m.graph, {s->root}));
+            std::cout << fmt::format("shape {} ({} coordinates):\n{}", s->name, s->dimension,
+                                     ir::print_graph(m.graph, {s->root}));
         } else if (emit == "tape") {
-            std::cout << fmt::format("shape {}:\n{}", s->name, ir::print_tape(ir::build_tape(m.graph, s->root, s->dimension)));
+            std::cout << fmt::format("shape {}:\n{}", s->name,
+                                     ir::print_tape(ir::build_tape(m.graph, s->root, s->dimension)));
         }
     }
     if (emit.empty())
@@ -92,31 +94,39 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 int run_render(const std::string& file, const RenderOptions& o, const EngineOptions& engine) {
     if (o.output.empty() && o.ascii.empty()) throw RunError("give -o out.png|out.svg or --ascii COLSxROWS");
     rt::PictureKind kind = rt::PictureKind::both;
-    if (o.kind == "process") kind = rt::PictureKind::process;
-    else if (o.kind == "cover") kind = rt::PictureKind::cover;
-    else if (o.kind != "both") throw RunError(fmt::format("unknown picture kind '{}' (process, cover, both)", o.kind));
+    if (o.kind == "process")
+        kind = rt::PictureKind::process;
+    else if (o.kind == "cover")
+        kind = rt::PictureKind::cover;
+    else if (o.kind != "both")
+        throw RunError(fmt::format("unknown picture kind '{}' (process, cover, both)", o.kind));
     if (!o.output.empty() && !ends_with(o.output, ".png") && !ends_with(o.output, ".svg"))
         throw RunError(fmt::format("cannot tell the picture format of '{}': use .png or .svg", o.output));
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
     const front::ShapeInfo& s = pick_shape(*c, o.shape);
-    if (s.dimension != 2) throw RunError(fmt::format("shape '{}' is {}D; pictures are of 2D shapes", s.name, s.dimension));
+    if (s.dimension != 2)
+        throw RunError(fmt::format("shape '{}' is {}D; pictures are of 2D shapes", s.name, s.dimension));
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
     const rt::RssResult r = cover(s, box, o.depth, o.split, true, *eval);
-    std::cerr << fmt::format("{}: depth {}, {} boxes evaluated: {} inside, {} outside, {} boundary; {:.3f} s\n",
-                             s.name, o.depth, r.evaluated, r.inside, r.outside, r.boundary, r.seconds);
+    std::cerr << fmt::format(
+        "{}: depth {}, {} boxes evaluated: {} inside, {} outside, {} boundary; {:.3f} s\n", s.name, o.depth,
+        r.evaluated, r.inside, r.outside, r.boundary, r.seconds);
     if (!o.ascii.empty()) {
         int cols = 0, rows = 0;
-        if (std::sscanf(o.ascii.c_str(), "%dx%d", &cols, &rows) != 2 || cols < 1 || rows < 1 || cols > 1000 || rows > 1000)
+        if (std::sscanf(o.ascii.c_str(), "%dx%d", &cols, &rows) != 2 || cols < 1 || rows < 1 || cols > 1000 ||
+            rows > 1000)
             throw RunError(fmt::format("--ascii needs COLSxROWS such as 64x32, not '{}'", o.ascii));
         std::cout << rt::ascii_picture(r, cols, rows);
     }
     if (!o.output.empty()) {
         if (o.size < 16 || o.size > 8192) throw RunError("--size must be between 16 and 8192 pixels");
         try {
-            if (ends_with(o.output, ".png")) rt::write_png(r, o.output, kind, o.size);
-            else rt::write_svg(r, o.output, kind);
+            if (ends_with(o.output, ".png"))
+                rt::write_png(r, o.output, kind, o.size);
+            else
+                rt::write_svg(r, o.output, kind);
         } catch (const std::runtime_error& e) {
             throw RunError(e.what());
         }
@@ -138,9 +148,10 @@ int run_dimension(const std::string& file, const std::string& shape, int from, i
     } catch (const std::invalid_argument& e) {
         throw RunError(e.what());
     }
-    for (const auto& [level, count] : d.counts) std::cout << fmt::format("level {:2}: {} boxes\n", level, count);
-    std::cout << fmt::format("box-counting dimension of {}: {:.4f} (r^2 = {:.5f}, levels {}..{}, split {})\n", s.name,
-                             d.dimension, d.r_squared, from, to, split);
+    for (const auto& [level, count] : d.counts)
+        std::cout << fmt::format("level {:2}: {} boxes\n", level, count);
+    std::cout << fmt::format("box-counting dimension of {}: {:.4f} (r^2 = {:.5f}, levels {}..{}, split {})\n",
+                             s.name, d.dimension, d.r_squared, from, to, split);
     return 0;
 }
 

@@ -12,14 +12,16 @@ int main(int argc, char** argv) {
     cli::EngineOptions engine;
     auto add_engine = [&](CLI::App* sub) {
         sub->add_option("--engine", engine.engine, "evaluation engine")->check(CLI::IsMember({"interp"}));
-        sub->add_option("--max-terms", engine.eval.max_terms, "most terms of an infinite series before its tail bound")
+        sub->add_option("--max-terms", engine.eval.max_terms,
+                        "most terms of an infinite series before its tail bound")
             ->check(CLI::Range(1, ir::max_terms_limit));
     };
 
     std::string file, shape, emit, at, box;
     auto* check = app.add_subcommand("check", "parse, check and lower a model; --emit shows a stage");
     check->add_option("file", file, "model file")->required();
-    check->add_option("--emit", emit, "print the ast, the ir graph or the tape")->check(CLI::IsMember({"ast", "ir", "tape"}));
+    check->add_option("--emit", emit, "print the ast, the ir graph or the tape")
+        ->check(CLI::IsMember({"ast", "ir", "tape"}));
     check->add_option("--shape", shape, "only this shape");
 
     auto* eval = app.add_subcommand("eval", "evaluate a shape at a point or over a box");
@@ -43,7 +45,8 @@ int main(int argc, char** argv) {
     add_engine(render);
 
     int from = 4, to = 9, split = 2;
-    auto* dimension = app.add_subcommand("dimension", "box-counting dimension of a shape's boundary from its cover");
+    auto* dimension =
+        app.add_subcommand("dimension", "box-counting dimension of a shape's boundary from its cover");
     dimension->add_option("file", file, "model file")->required();
     dimension->add_option("shape", shape, "shape name (default: the last shape of the file)");
     dimension->add_option("--from", from, "first level of the fit")->check(CLI::Range(0, 64));

@@ -25,7 +25,8 @@ const front::ShapeInfo& find_shape(const front::Compilation& c, const std::strin
     if (const front::ShapeInfo* s = c.module.find_shape(name)) return *s;
     std::string known;
     for (const auto& s : c.module.shapes) known += (known.empty() ? "" : ", ") + s.name;
-    throw RunError(fmt::format("no shape '{}' in the model (shapes: {})", name, known.empty() ? "none" : known));
+    throw RunError(
+        fmt::format("no shape '{}' in the model (shapes: {})", name, known.empty() ? "none" : known));
 }
 
 const front::ShapeInfo& pick_shape(const front::Compilation& c, const std::string& name) {
@@ -40,7 +41,8 @@ std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId
     ir::Tape tape = ir::build_tape(m.graph, root, inputs);
     if (std::string defect = ir::verify_tape(tape); !defect.empty())
         throw front::InternalError("malformed tape: " + defect);
-    if (options.engine != "interp") throw RunError(fmt::format("unknown engine '{}' (available: interp)", options.engine));
+    if (options.engine != "interp")
+        throw RunError(fmt::format("unknown engine '{}' (available: interp)", options.engine));
     return interp::make_interpreter(std::move(tape), options.eval);
 }
 
@@ -70,7 +72,8 @@ ir::Interval parse_number(const std::string& text) {
 std::vector<ir::Interval> parse_box(const std::string& text, int dimension) {
     const auto axes = split(text, ',');
     if (static_cast<int>(axes.size()) != dimension)
-        throw RunError(fmt::format("the box '{}' has {} axes, the shape has {} coordinates", text, axes.size(), dimension));
+        throw RunError(fmt::format("the box '{}' has {} axes, the shape has {} coordinates", text,
+                                   axes.size(), dimension));
     std::vector<ir::Interval> box;
     for (const std::string& axis : axes) {
         const auto bounds = split(axis, ':');
@@ -82,10 +85,12 @@ std::vector<ir::Interval> parse_box(const std::string& text, int dimension) {
     return box;
 }
 
-std::vector<double> parse_point(const std::string& text, int dimension, std::vector<ir::Interval>* enclosure) {
+std::vector<double> parse_point(const std::string& text, int dimension,
+                                std::vector<ir::Interval>* enclosure) {
     const auto coords = split(text, ',');
     if (static_cast<int>(coords.size()) != dimension)
-        throw RunError(fmt::format("the point '{}' has {} coordinates, the shape has {}", text, coords.size(), dimension));
+        throw RunError(fmt::format("the point '{}' has {} coordinates, the shape has {}", text, coords.size(),
+                                   dimension));
     std::vector<double> p;
     for (const std::string& c : coords) {
         const ir::Interval v = parse_number(c);
@@ -100,7 +105,8 @@ std::string format_interval(ir::Interval v) {
     return fmt::format("[{}, {}]", v.lo, v.hi);
 }
 
-std::vector<ir::Interval> answer_queries(const front::Module& m, const ir::Tape& tape, const EngineOptions& options,
+std::vector<ir::Interval> answer_queries(const front::Module& m, const ir::Tape& tape,
+                                         const EngineOptions& options,
                                          std::vector<std::optional<ir::Interval>>& answers) {
     answers.resize(m.queries.size());
     std::vector<ir::Interval> inputs(m.queries.size(), ir::Interval(0.0));

@@ -40,7 +40,8 @@ std::vector<double> parse_point(const std::string& text, int dimension, std::vec
 std::string format_interval(ir::Interval v);
 
 // Runs the model's queries (enclose, dimension) that `tape` reads, caching answers in `answers`.
-std::vector<ir::Interval> answer_queries(const front::Module& m, const ir::Tape& tape, const EngineOptions& options,
+std::vector<ir::Interval> answer_queries(const front::Module& m, const ir::Tape& tape,
+                                         const EngineOptions& options,
                                          std::vector<std::optional<ir::Interval>>& answers);
 
 } // namespace frac::cli

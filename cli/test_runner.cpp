@@ -55,7 +55,9 @@ void run_prints(const front::Compilation& c, const EngineOptions& engine,
             std::cout << s << "\n";
             break;
         }
-        case front::ValueKind::boolean: std::cout << truth_text(enclose_closed(m, p.nodes[0], engine, answers, nullptr)) << "\n"; break;
+        case front::ValueKind::boolean:
+            std::cout << truth_text(enclose_closed(m, p.nodes[0], engine, answers, nullptr)) << "\n";
+            break;
         case front::ValueKind::scalar:
         case front::ValueKind::point: {
             std::string s;
@@ -97,9 +99,10 @@ int run_tests(const std::vector<std::string>& files, bool prints, const EngineOp
                         const ir::Interval v = enclose_closed(c->module, n, engine, answers, &pt);
                         shown += (shown.empty() ? "" : ", ") + value_text(v, pt);
                     }
-                    problems.push_back(fmt::format("  {}:{}:{}: expectation is {}{}\n    {}", c->sources.name(x.loc.file),
-                                                   x.loc.line, x.loc.column, truth_text(truth),
-                                                   shown.empty() ? "" : " (values: " + shown + ")", x.source));
+                    problems.push_back(
+                        fmt::format("  {}:{}:{}: expectation is {}{}\n    {}", c->sources.name(x.loc.file),
+                                    x.loc.line, x.loc.column, truth_text(truth),
+                                    shown.empty() ? "" : " (values: " + shown + ")", x.source));
                 } catch (const RunError& e) {
                     problems.push_back(fmt::format("  {}:{}:{}: {}", c->sources.name(x.loc.file), x.loc.line,
                                                    x.loc.column, e.what()));

@@ -66,11 +66,11 @@ struct Expect {
 struct Item {
     ItemKind kind;
     Location loc;
-    std::string name;          // fn/const/shape name, test title, import path
-    std::vector<Param> params; // fn, shape
-    bool has_params = false;   // shape with an explicit parameter list
-    ExprPtr over;              // shape: default box, or null
-    ExprPtr body;              // fn/const/shape/print
+    std::string name;            // fn/const/shape name, test title, import path
+    std::vector<Param> params;   // fn, shape
+    bool has_params = false;     // shape with an explicit parameter list
+    ExprPtr over;                // shape: default box, or null
+    ExprPtr body;                // fn/const/shape/print
     std::vector<Expect> expects; // test
 };
 

@@ -36,7 +36,8 @@ const char* op_text(Tok op) {
 std::string print_expr(const Expr& e) {
     auto kids = [&](std::size_t from = 0) {
         std::string s;
-        for (std::size_t i = from; i < e.kids.size(); ++i) s += " " + (e.kids[i] ? print_expr(*e.kids[i]) : "inf");
+        for (std::size_t i = from; i < e.kids.size(); ++i)
+            s += " " + (e.kids[i] ? print_expr(*e.kids[i]) : "inf");
         return s;
     };
     switch (e.kind) {
@@ -53,7 +54,8 @@ std::string print_expr(const Expr& e) {
     case ExprKind::let: {
         std::string s = "(let (";
         for (std::size_t i = 0; i < e.bindings.size(); ++i)
-            s += (i ? " " : "") + fmt::format("({} {})", e.bindings[i].name, print_expr(*e.bindings[i].value));
+            s +=
+                (i ? " " : "") + fmt::format("({} {})", e.bindings[i].name, print_expr(*e.bindings[i].value));
         return s + ")" + kids() + ")";
     }
     case ExprKind::tuple: return fmt::format("(point{})", kids());
@@ -72,7 +74,9 @@ std::string print_ast(const Program& p, std::uint32_t file) {
         for (std::size_t i = 0; i < it.params.size(); ++i) params += (i ? " " : "") + it.params[i].name;
         switch (it.kind) {
         case ItemKind::import: out += fmt::format("(import \"{}\")\n", it.name); break;
-        case ItemKind::fn: out += fmt::format("(fn {} ({}) {})\n", it.name, params, print_expr(*it.body)); break;
+        case ItemKind::fn:
+            out += fmt::format("(fn {} ({}) {})\n", it.name, params, print_expr(*it.body));
+            break;
         case ItemKind::const_: out += fmt::format("(const {} {})\n", it.name, print_expr(*it.body)); break;
         case ItemKind::shape:
             out += fmt::format("(shape {} ({}){} {})\n", it.name, params,
@@ -81,7 +85,8 @@ std::string print_ast(const Program& p, std::uint32_t file) {
         case ItemKind::test:
             out += fmt::format("(test \"{}\"", it.name);
             for (const Expect& e : it.expects)
-                out += fmt::format("\n  (expect {}{})", print_expr(*e.expr), e.within ? " (within " + print_expr(*e.within) + ")" : "");
+                out += fmt::format("\n  (expect {}{})", print_expr(*e.expr),
+                                   e.within ? " (within " + print_expr(*e.within) + ")" : "");
             out += ")\n";
             break;
         case ItemKind::print: out += fmt::format("(print {})\n", print_expr(*it.body)); break;

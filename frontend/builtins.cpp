@@ -7,14 +7,22 @@ namespace {
 using ir::Op;
 
 constexpr Builtin builtins[] = {
-    {"sqrt", BuiltinKind::unary, 1, 1, Op::Sqrt},     {"abs", BuiltinKind::unary, 1, 1, Op::Abs},
-    {"floor", BuiltinKind::unary, 1, 1, Op::Floor},   {"ceil", BuiltinKind::unary, 1, 1, Op::Ceil},
-    {"dz", BuiltinKind::unary, 1, 1, Op::Dz},         {"sin", BuiltinKind::unary, 1, 1, Op::Sin},
-    {"cos", BuiltinKind::unary, 1, 1, Op::Cos},       {"tan", BuiltinKind::unary, 1, 1, Op::Tan},
-    {"exp", BuiltinKind::unary, 1, 1, Op::Exp},       {"log", BuiltinKind::unary, 1, 1, Op::Log},
-    {"atan2", BuiltinKind::binary, 2, 2, Op::Atan2},  {"min", BuiltinKind::variadic, 2, 64, Op::Min},
-    {"max", BuiltinKind::variadic, 2, 64, Op::Max},   {"mod", BuiltinKind::mod, 2, 2, Op::Mod1},
-    {"pow", BuiltinKind::pow, 2, 2, Op::Pow},         {"enclose", BuiltinKind::enclose, 2, 2, Op::Const},
+    {"sqrt", BuiltinKind::unary, 1, 1, Op::Sqrt},
+    {"abs", BuiltinKind::unary, 1, 1, Op::Abs},
+    {"floor", BuiltinKind::unary, 1, 1, Op::Floor},
+    {"ceil", BuiltinKind::unary, 1, 1, Op::Ceil},
+    {"dz", BuiltinKind::unary, 1, 1, Op::Dz},
+    {"sin", BuiltinKind::unary, 1, 1, Op::Sin},
+    {"cos", BuiltinKind::unary, 1, 1, Op::Cos},
+    {"tan", BuiltinKind::unary, 1, 1, Op::Tan},
+    {"exp", BuiltinKind::unary, 1, 1, Op::Exp},
+    {"log", BuiltinKind::unary, 1, 1, Op::Log},
+    {"atan2", BuiltinKind::binary, 2, 2, Op::Atan2},
+    {"min", BuiltinKind::variadic, 2, 64, Op::Min},
+    {"max", BuiltinKind::variadic, 2, 64, Op::Max},
+    {"mod", BuiltinKind::mod, 2, 2, Op::Mod1},
+    {"pow", BuiltinKind::pow, 2, 2, Op::Pow},
+    {"enclose", BuiltinKind::enclose, 2, 2, Op::Const},
     {"dimension", BuiltinKind::dimension, 3, 4, Op::Const},
 };
 
@@ -26,6 +34,8 @@ const Builtin* find_builtin(const std::string& name) {
     return nullptr;
 }
 
-bool is_builtin_constant(const std::string& name) { return name == "pi" || name == "e"; }
+bool is_builtin_constant(const std::string& name) {
+    return name == "pi" || name == "e";
+}
 
 } // namespace frac::front

@@ -5,7 +5,9 @@
 
 namespace frac::front {
 
-SourceManager::SourceManager() { files_.push_back({"<unknown>", ""}); }
+SourceManager::SourceManager() {
+    files_.push_back({"<unknown>", ""});
+}
 
 std::uint32_t SourceManager::add(std::string name, std::string text) {
     files_.push_back({std::move(name), std::move(text)});
@@ -30,25 +32,32 @@ void Diagnostics::error(Location loc, std::string message) {
     if (errors_ <= max_errors) list_.push_back({Severity::error, loc, std::move(message)});
 }
 
-void Diagnostics::note(Location loc, std::string message) { list_.push_back({Severity::note, loc, std::move(message)}); }
+void Diagnostics::note(Location loc, std::string message) {
+    list_.push_back({Severity::note, loc, std::move(message)});
+}
 
 std::string Diagnostics::render(const SourceManager& sm) const {
     std::vector<Diagnostic> sorted = list_;
     std::stable_sort(sorted.begin(), sorted.end(), [](const Diagnostic& a, const Diagnostic& b) {
-        return std::tie(a.loc.file, a.loc.line, a.loc.column) < std::tie(b.loc.file, b.loc.line, b.loc.column);
+        return std::tie(a.loc.file, a.loc.line, a.loc.column) <
+               std::tie(b.loc.file, b.loc.line, b.loc.column);
     });
     std::string out;
     for (const Diagnostic& d : sorted) {
-        const char* kind = d.severity == Severity::error ? "error" : d.severity == Severity::warning ? "warning" : "note";
+        const char* kind = d.severity == Severity::error     ? "error"
+                           : d.severity == Severity::warning ? "warning"
+                                                             : "note";
         if (d.loc.file != 0)
-            out += fmt::format("{}:{}:{}: {}: {}\n", sm.name(d.loc.file), d.loc.line, d.loc.column, kind, d.message);
+            out += fmt::format("{}:{}:{}: {}: {}\n", sm.name(d.loc.file), d.loc.line, d.loc.column, kind,
+                               d.message);
         else
             out += fmt::format("{}: {}\n", kind, d.message);
         const std::string line = sm.line_text(d.loc);
         if (!line.empty()) {
             out += "  " + line + "\n";
             std::string caret = "  ";
-            for (std::uint32_t c = 1; c < d.loc.column && c - 1 < line.size(); ++c) caret += line[c - 1] == '\t' ? '\t' : ' ';
+            for (std::uint32_t c = 1; c < d.loc.column && c - 1 < line.size(); ++c)
+                caret += line[c - 1] == '\t' ? '\t' : ' ';
             out += caret + "^\n";
         }
     }

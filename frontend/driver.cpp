@@ -60,13 +60,15 @@ private:
                 c_.diags.error(it.loc, fmt::format("no standard library module '{}'", spec));
                 return;
             }
-            if (seen_.insert("std:" + spec).second) load(fmt::format("<stdlib>/{}.frac", spec), lib->second, dir);
+            if (seen_.insert("std:" + spec).second)
+                load(fmt::format("<stdlib>/{}.frac", spec), lib->second, dir);
             return;
         }
         const std::filesystem::path path = (dir / spec).lexically_normal();
         std::error_code ec;
         const auto canonical = std::filesystem::weakly_canonical(path, ec);
-        if (!seen_.insert(ec ? path.string() : canonical.string()).second) return; // imported already (or a cycle)
+        if (!seen_.insert(ec ? path.string() : canonical.string()).second)
+            return; // imported already (or a cycle)
         std::string text, why;
         if (!read_file(path.string(), text, why)) {
             c_.diags.error(it.loc, fmt::format("cannot read '{}': {}", path.string(), why));
@@ -90,8 +92,8 @@ void finish(Compilation& c, const Limits& limits, StopAfter stop) {
 
 } // namespace
 
-std::unique_ptr<Compilation> compile_source(const std::string& name, const std::string& text, const Limits& limits,
-                                            StopAfter stop) {
+std::unique_ptr<Compilation> compile_source(const std::string& name, const std::string& text,
+                                            const Limits& limits, StopAfter stop) {
     auto c = std::make_unique<Compilation>();
     Loader(*c).load(name, text, std::filesystem::current_path());
     finish(*c, limits, stop);

@@ -79,13 +79,16 @@ private:
         }
     }
 
-    [[noreturn]] static void fail(Location loc, const std::string& message) { throw CompileError(loc, message); }
+    [[noreturn]] static void fail(Location loc, const std::string& message) {
+        throw CompileError(loc, message);
+    }
 
     // ---- items ----
     std::size_t shape_info(const Item& it) {
         if (auto done = shape_index_.find(&it); done != shape_index_.end()) {
             if (done->second == failed) throw AlreadyReported{};
-            if (done->second == in_progress) fail(it.loc, fmt::format("shape '{}' is defined in terms of itself", it.name));
+            if (done->second == in_progress)
+                fail(it.loc, fmt::format("shape '{}' is defined in terms of itself", it.name));
             return done->second;
         }
         shape_index_[&it] = in_progress;
@@ -104,7 +107,8 @@ private:
         if (it.over) {
             const Value box = closed(*it.over, Context::constant);
             if (box.kind != ValueKind::box)
-                fail(it.over->loc, fmt::format("'over' needs a box such as [0, 1] × [0, 1], found {}", kind_name(box.kind)));
+                fail(it.over->loc, fmt::format("'over' needs a box such as [0, 1] × [0, 1], found {}",
+                                               kind_name(box.kind)));
             info.box = box.box;
         }
         if (it.has_params) {
@@ -131,10 +135,13 @@ private:
         const int dim = it.has_params ? static_cast<int>(it.params.size()) : static_cast<int>(coords.size());
         Scope scope;
         static const char* implicit[] = {"x", "y", "z"};
-        for (int k = 0; k < dim; ++k) scope.emplace_back(it.has_params ? it.params[static_cast<std::size_t>(k)].name : implicit[k], coords[static_cast<std::size_t>(k)]);
+        for (int k = 0; k < dim; ++k)
+            scope.emplace_back(it.has_params ? it.params[static_cast<std::size_t>(k)].name : implicit[k],
+                               coords[static_cast<std::size_t>(k)]);
         const Value v = inline_body(it, std::move(scope), call_loc, Context::shape);
         if (v.kind != ValueKind::scalar)
-            fail(it.body->loc, fmt::format("a shape's function must be a number (negative inside), found {}", kind_name(v.kind)));
+            fail(it.body->loc, fmt::format("a shape's function must be a number (negative inside), found {}",
+                                           kind_name(v.kind)));
         return v.nodes[0];
     }
 
@@ -181,7 +188,8 @@ private:
                 } else {
                     const Value v = closed(*e.expr, Context::test);
                     if (v.kind != ValueKind::boolean)
-                        fail(e.expr->loc, fmt::format("'expect' needs a condition, found {}", kind_name(v.kind)));
+                        fail(e.expr->loc,
+                             fmt::format("'expect' needs a condition, found {}", kind_name(v.kind)));
                     x.truth = v.nodes[0];
                     if (e.expr->kind == ExprKind::binary && e.expr->kids.size() == 2) {
                         for (const ExprPtr& side : e.expr->kids) {
@@ -198,7 +206,8 @@ private:
 
     void print(const Item& it) {
         const Value v = closed(*it.body, Context::test);
-        if (v.shape) fail(it.body->loc, "cannot print a shape; print enclose(shape, box) or its value at a point");
+        if (v.shape)
+            fail(it.body->loc, "cannot print a shape; print enclose(shape, box) or its value at a point");
         m_.prints.push_back({it.loc, v.kind, v.nodes, v.box});
     }
 
@@ -220,8 +229,10 @@ private:
     Value inline_body(const Item& it, Scope params, Location call_loc, Context ctx) {
         for (const Item* active : call_stack_)
             if (active == &it)
-                fail(call_loc, fmt::format("recursive call of '{}': functions are inlined, so recursion is not "
-                                           "supported (write a series instead)", it.name));
+                fail(call_loc,
+                     fmt::format("recursive call of '{}': functions are inlined, so recursion is not "
+                                 "supported (write a series instead)",
+                                 it.name));
         if (static_cast<int>(call_stack_.size()) >= limits_.max_inline_depth)
             fail(call_loc, fmt::format("calls nested deeper than the limit of {}", limits_.max_inline_depth));
         // A body sees its parameters and the globals; series levels continue from the caller's.
@@ -251,11 +262,13 @@ private:
     NodeId scalar(const Value& v, Location loc) {
         if (v.shape) fail(loc, "a shape is not a number here; call it with coordinates");
         if (v.kind == ValueKind::interval) return g_.constant(v.box[0], num::midpoint(v.box[0]));
-        if (v.kind != ValueKind::scalar) fail(loc, fmt::format("expected a number, found {}", kind_name(v.kind)));
+        if (v.kind != ValueKind::scalar)
+            fail(loc, fmt::format("expected a number, found {}", kind_name(v.kind)));
         return v.nodes[0];
     }
     NodeId boolean(const Value& v, Location loc) {
-        if (v.kind != ValueKind::boolean) fail(loc, fmt::format("expected a condition, found {}", kind_name(v.kind)));
+        if (v.kind != ValueKind::boolean)
+            fail(loc, fmt::format("expected a condition, found {}", kind_name(v.kind)));
         return v.nodes[0];
     }
 
@@ -280,22 +293,26 @@ private:
         case ExprKind::tuple: {
             Value v;
             v.kind = ValueKind::point;
-            if (e.kids.size() > 3) fail(e.loc, fmt::format("points have 2 or 3 coordinates, this one has {}", e.kids.size()));
+            if (e.kids.size() > 3)
+                fail(e.loc, fmt::format("points have 2 or 3 coordinates, this one has {}", e.kids.size()));
             for (const ExprPtr& k : e.kids) v.nodes.push_back(scalar(expr(*k), k->loc));
             return v;
         }
         case ExprKind::field: {
             const Value p = expr(*e.kids[0]);
-            if (p.kind != ValueKind::point) fail(e.loc, fmt::format("'.{}' needs a point, found {}", e.text, kind_name(p.kind)));
+            if (p.kind != ValueKind::point)
+                fail(e.loc, fmt::format("'.{}' needs a point, found {}", e.text, kind_name(p.kind)));
             const std::size_t k = e.text == "x" ? 0 : e.text == "y" ? 1 : e.text == "z" ? 2 : 99;
             if (k >= p.nodes.size())
-                fail(e.loc, fmt::format("a point of {} coordinates has no component '{}'", p.nodes.size(), e.text));
+                fail(e.loc,
+                     fmt::format("a point of {} coordinates has no component '{}'", p.nodes.size(), e.text));
             return Value::scalar(p.nodes[k]);
         }
         case ExprKind::interval: {
             const NodeId lo = scalar(expr(*e.kids[0]), e.kids[0]->loc);
             const NodeId hi = scalar(expr(*e.kids[1]), e.kids[1]->loc);
-            if (!g_.is_const(lo) || !g_.is_const(hi)) fail(e.loc, "the bounds of an interval must be constants");
+            if (!g_.is_const(lo) || !g_.is_const(hi))
+                fail(e.loc, "the bounds of an interval must be constants");
             const Interval v{g_[lo].value.lo, g_[hi].value.hi};
             if (!(v.lo <= v.hi) || std::isnan(v.lo) || std::isnan(v.hi))
                 fail(e.loc, "the lower bound of an interval must not exceed its upper bound");
@@ -311,7 +328,8 @@ private:
 
     Value number(const Expr& e) {
         const Interval v = num::from_decimal(e.text);
-        if (!std::isfinite(v.lo) || !std::isfinite(v.hi)) fail(e.loc, fmt::format("number '{}' is too large", e.text));
+        if (!std::isfinite(v.lo) || !std::isfinite(v.hi))
+            fail(e.loc, fmt::format("number '{}' is too large", e.text));
         return Value::scalar(g_.constant(v, std::strtod(e.text.c_str(), nullptr)));
     }
 
@@ -337,7 +355,8 @@ private:
             const Item& it = *g->second;
             if (it.kind == ItemKind::fn) {
                 Scope params;
-                for (std::size_t i = 0; i < it.params.size(); ++i) params.emplace_back(it.params[i].name, expr(*e.args[i].value));
+                for (std::size_t i = 0; i < it.params.size(); ++i)
+                    params.emplace_back(it.params[i].name, expr(*e.args[i].value));
                 return inline_body(it, std::move(params), e.loc, frames_.back().ctx);
             }
             if (it.kind == ItemKind::shape) return Value::scalar(call_shape(it, e));
@@ -374,11 +393,13 @@ private:
         if (e.args.size() == 1) {
             const Value p = expr(*e.args[0].value);
             if (p.kind != ValueKind::point || static_cast<int>(p.nodes.size()) != dim)
-                fail(e.args[0].loc, fmt::format("shape '{}' takes {} coordinates or a point of {}", it.name, dim, dim));
+                fail(e.args[0].loc,
+                     fmt::format("shape '{}' takes {} coordinates or a point of {}", it.name, dim, dim));
             for (NodeId n : p.nodes) coords.push_back(Value::scalar(n));
         } else {
             if (static_cast<int>(e.args.size()) != dim)
-                fail(e.loc, fmt::format("shape '{}' takes {} coordinates, {} given", it.name, dim, e.args.size()));
+                fail(e.loc,
+                     fmt::format("shape '{}' takes {} coordinates, {} given", it.name, dim, e.args.size()));
             for (const Arg& a : e.args) coords.push_back(Value::scalar(scalar(expr(*a.value), a.loc)));
         }
         return shape_body(it, coords, e.loc);
@@ -386,7 +407,9 @@ private:
 
     Value query(const Expr& e, const Builtin& b) {
         if (frames_.back().ctx != Context::test)
-            fail(e.loc, fmt::format("'{}' runs a computation on a shape; it is available in tests and print only", e.text));
+            fail(e.loc,
+                 fmt::format("'{}' runs a computation on a shape; it is available in tests and print only",
+                             e.text));
         const Value s = expr(*e.args[0].value);
         if (!s.shape) fail(e.args[0].loc, fmt::format("'{}' needs a shape as its first argument", e.text));
         Query q;
@@ -395,10 +418,11 @@ private:
         const ShapeInfo& info = m_.shapes[q.shape];
         if (b.kind == BuiltinKind::enclose) {
             const Value box = expr(*e.args[1].value);
-            if (box.kind != ValueKind::box) fail(e.args[1].loc, fmt::format("'enclose' needs a box, found {}", kind_name(box.kind)));
+            if (box.kind != ValueKind::box)
+                fail(e.args[1].loc, fmt::format("'enclose' needs a box, found {}", kind_name(box.kind)));
             if (static_cast<int>(box.box.size()) != info.dimension)
-                fail(e.args[1].loc, fmt::format("shape '{}' has {} coordinates, the box has {} axes", info.name,
-                                                info.dimension, box.box.size()));
+                fail(e.args[1].loc, fmt::format("shape '{}' has {} coordinates, the box has {} axes",
+                                                info.name, info.dimension, box.box.size()));
             q.kind = Query::Kind::enclose;
             q.box = box.box;
         } else {
@@ -409,7 +433,8 @@ private:
                 const Arg& a = e.args[i];
                 std::int64_t v = 0;
                 const NodeId n = scalar(expr(*a.value), a.loc);
-                if (!g_.const_integer(n, v)) fail(a.loc, fmt::format("'{}:' needs an integer constant", a.name));
+                if (!g_.const_integer(n, v))
+                    fail(a.loc, fmt::format("'{}:' needs an integer constant", a.name));
                 if (a.name == "from") {
                     q.from = static_cast<int>(v);
                     have_from = true;
@@ -498,7 +523,10 @@ private:
     }
 
     Value arithmetic(const Expr& e, const Value& a, const Value& b) {
-        const Op op = e.op == Tok::plus ? Op::Add : e.op == Tok::minus ? Op::Sub : e.op == Tok::star ? Op::Mul : Op::Div;
+        const Op op = e.op == Tok::plus    ? Op::Add
+                      : e.op == Tok::minus ? Op::Sub
+                      : e.op == Tok::star  ? Op::Mul
+                                           : Op::Div;
         const Location la = e.kids[0]->loc, lb = e.kids[1]->loc;
         const bool pa = a.kind == ValueKind::point, pb = b.kind == ValueKind::point;
         if (!pa && !pb) return Value::scalar(g_.op(op, scalar(a, la), scalar(b, lb)));
@@ -507,7 +535,8 @@ private:
         if (pa && pb) {
             if (op == Op::Mul || op == Op::Div) fail(e.loc, "points multiply or divide by numbers only");
             if (a.nodes.size() != b.nodes.size()) fail(e.loc, "points of different dimensions");
-            for (std::size_t i = 0; i < a.nodes.size(); ++i) r.nodes.push_back(g_.op(op, a.nodes[i], b.nodes[i]));
+            for (std::size_t i = 0; i < a.nodes.size(); ++i)
+                r.nodes.push_back(g_.op(op, a.nodes[i], b.nodes[i]));
             return r;
         }
         if (op == Op::Add || op == Op::Sub) fail(e.loc, "a point and a number cannot be added; use a point");
@@ -523,11 +552,14 @@ private:
         const Value a = expr(*e.kids[1]);
         const Value b = expr(*e.kids[2]);
         if (a.kind == ValueKind::interval || a.kind == ValueKind::box || a.shape)
-            fail(e.kids[1]->loc, fmt::format("'if' chooses between numbers, points or conditions, found {}", kind_name(a.kind)));
+            fail(e.kids[1]->loc, fmt::format("'if' chooses between numbers, points or conditions, found {}",
+                                             kind_name(a.kind)));
         if (a.kind != b.kind || a.nodes.size() != b.nodes.size())
-            fail(e.kids[2]->loc, fmt::format("the branches of 'if' differ: {} and {}", kind_name(a.kind), kind_name(b.kind)));
+            fail(e.kids[2]->loc,
+                 fmt::format("the branches of 'if' differ: {} and {}", kind_name(a.kind), kind_name(b.kind)));
         Value r = a;
-        for (std::size_t i = 0; i < a.nodes.size(); ++i) r.nodes[i] = g_.op(Op::Select, c, a.nodes[i], b.nodes[i]);
+        for (std::size_t i = 0; i < a.nodes.size(); ++i)
+            r.nodes[i] = g_.op(Op::Select, c, a.nodes[i], b.nodes[i]);
         return r;
     }
 
@@ -536,7 +568,8 @@ private:
         auto integer = [&](const Expr& x, const char* what) {
             const NodeId n = scalar(expr(x), x.loc);
             std::int64_t v = 0;
-            if (!g_.const_integer(n, v)) fail(x.loc, fmt::format("the {} of a series index must be an integer constant", what));
+            if (!g_.const_integer(n, v))
+                fail(x.loc, fmt::format("the {} of a series index must be an integer constant", what));
             return v;
         };
         ir::SeriesData data;
@@ -544,10 +577,14 @@ private:
         const bool infinite = e.kids[1] == nullptr;
         if (!infinite) {
             data.end = integer(*e.kids[1], "end");
-            if (data.end < data.start) fail(e.loc, fmt::format("empty index range {}..{}", data.start, data.end));
+            if (data.end < data.start)
+                fail(e.loc, fmt::format("empty index range {}..{}", data.start, data.end));
             if (data.end - data.start + 1 > limits_.max_finite_terms)
-                fail(e.loc, fmt::format("this series has {} terms, over the limit of {} (use an infinite series, whose "
-                                        "tail is bounded)", data.end - data.start + 1, limits_.max_finite_terms));
+                fail(e.loc,
+                     fmt::format(
+                         "this series has {} terms, over the limit of {} (use an infinite series, whose "
+                         "tail is bounded)",
+                         data.end - data.start + 1, limits_.max_finite_terms));
         } else if (data.start < 0) {
             fail(e.kids[0]->loc, "an infinite series must start at an index >= 0");
         }

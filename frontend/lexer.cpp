@@ -65,17 +65,19 @@ namespace {
 
 const std::unordered_map<std::string, Tok>& keywords() {
     static const std::unordered_map<std::string, Tok> k = {
-        {"fn", Tok::kw_fn},         {"const", Tok::kw_const},   {"let", Tok::kw_let},       {"in", Tok::kw_in},
-        {"if", Tok::kw_if},         {"then", Tok::kw_then},     {"else", Tok::kw_else},     {"and", Tok::kw_and},
-        {"or", Tok::kw_or},         {"not", Tok::kw_not},       {"shape", Tok::kw_shape},   {"over", Tok::kw_over},
-        {"test", Tok::kw_test},     {"expect", Tok::kw_expect}, {"within", Tok::kw_within}, {"import", Tok::kw_import},
-        {"print", Tok::kw_print}};
+        {"fn", Tok::kw_fn},         {"const", Tok::kw_const},   {"let", Tok::kw_let},
+        {"in", Tok::kw_in},         {"if", Tok::kw_if},         {"then", Tok::kw_then},
+        {"else", Tok::kw_else},     {"and", Tok::kw_and},       {"or", Tok::kw_or},
+        {"not", Tok::kw_not},       {"shape", Tok::kw_shape},   {"over", Tok::kw_over},
+        {"test", Tok::kw_test},     {"expect", Tok::kw_expect}, {"within", Tok::kw_within},
+        {"import", Tok::kw_import}, {"print", Tok::kw_print}};
     return k;
 }
 
 class Lexer {
 public:
-    Lexer(const std::string& text, std::uint32_t file, Diagnostics& diags) : s_(text), file_(file), diags_(diags) {}
+    Lexer(const std::string& text, std::uint32_t file, Diagnostics& diags)
+        : s_(text), file_(file), diags_(diags) {}
 
     std::vector<Token> run() {
         std::vector<Token> out;
@@ -137,7 +139,8 @@ private:
             t.kind = it == keywords().end() ? Tok::ident : it->second;
             return true;
         }
-        if (std::isdigit(static_cast<unsigned char>(c)) || (c == '.' && std::isdigit(static_cast<unsigned char>(peek(1))))) {
+        if (std::isdigit(static_cast<unsigned char>(c)) ||
+            (c == '.' && std::isdigit(static_cast<unsigned char>(peek(1))))) {
             while (std::isdigit(static_cast<unsigned char>(peek()))) advance();
             // "0..5" is a range, not the number "0."
             if (peek() == '.' && peek(1) != '.') {
@@ -167,7 +170,8 @@ private:
             advance();
             return true;
         }
-        if (static_cast<unsigned char>(c) == 0xC3 && static_cast<unsigned char>(peek(1)) == 0x97) { // U+00D7 ×
+        if (static_cast<unsigned char>(c) == 0xC3 &&
+            static_cast<unsigned char>(peek(1)) == 0x97) { // U+00D7 ×
             advance();
             advance();
             t.kind = Tok::times;
@@ -179,12 +183,13 @@ private:
             Tok kind;
         };
         static const Punct puncts[] = {
-            {"..", Tok::dotdot}, {"==", Tok::eq},     {"!=", Tok::ne},       {"<=", Tok::le},       {">=", Tok::ge},
-            {"(", Tok::lparen},  {")", Tok::rparen},  {"[", Tok::lbracket},  {"]", Tok::rbracket},  {"{", Tok::lbrace},
-            {"}", Tok::rbrace},  {",", Tok::comma},   {";", Tok::semicolon}, {":", Tok::colon},     {".", Tok::dot},
-            {"=", Tok::assign},  {"<", Tok::lt},      {">", Tok::gt},        {"+", Tok::plus},      {"-", Tok::minus},
-            {"*", Tok::star},    {"/", Tok::slash},   {"^", Tok::caret},     {"&", Tok::amp},       {"|", Tok::bar},
-            {"~", Tok::tilde}};
+            {"..", Tok::dotdot},   {"==", Tok::eq},    {"!=", Tok::ne},    {"<=", Tok::le},
+            {">=", Tok::ge},       {"(", Tok::lparen}, {")", Tok::rparen}, {"[", Tok::lbracket},
+            {"]", Tok::rbracket},  {"{", Tok::lbrace}, {"}", Tok::rbrace}, {",", Tok::comma},
+            {";", Tok::semicolon}, {":", Tok::colon},  {".", Tok::dot},    {"=", Tok::assign},
+            {"<", Tok::lt},        {">", Tok::gt},     {"+", Tok::plus},   {"-", Tok::minus},
+            {"*", Tok::star},      {"/", Tok::slash},  {"^", Tok::caret},  {"&", Tok::amp},
+            {"|", Tok::bar},       {"~", Tok::tilde}};
         for (const Punct& p : puncts) {
             const std::string_view text(p.text);
             if (s_.compare(pos_, text.size(), text) == 0) {

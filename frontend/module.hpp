@@ -25,8 +25,8 @@ struct ShapeInfo {
 struct Query {
     enum class Kind { enclose, dimension } kind = Kind::enclose;
     Location loc;
-    std::size_t shape = 0;          // index into Module::shapes
-    std::vector<Interval> box;      // enclose: the box; dimension: the root box
+    std::size_t shape = 0;           // index into Module::shapes
+    std::vector<Interval> box;       // enclose: the box; dimension: the root box
     int from = 0, to = 0, split = 2; // dimension: levels used for box counting
 };
 
@@ -34,9 +34,9 @@ enum class ValueKind { scalar, boolean, point, interval, box };
 
 struct Expectation {
     Location loc;
-    std::string source;              // the expression's source line, for messages
-    NodeId truth = ir::no_node;      // boolean: must evaluate to proven true
-    std::vector<NodeId> shown;       // values printed when it fails
+    std::string source;         // the expression's source line, for messages
+    NodeId truth = ir::no_node; // boolean: must evaluate to proven true
+    std::vector<NodeId> shown;  // values printed when it fails
 };
 
 struct TestInfo {
@@ -48,8 +48,8 @@ struct TestInfo {
 struct PrintInfo {
     Location loc;
     ValueKind kind = ValueKind::scalar;
-    std::vector<NodeId> nodes;  // scalar/boolean: 1; point: its components
-    std::vector<Interval> box;  // interval/box values
+    std::vector<NodeId> nodes; // scalar/boolean: 1; point: its components
+    std::vector<Interval> box; // interval/box values
 };
 
 struct Module {

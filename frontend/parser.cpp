@@ -55,8 +55,8 @@ private:
         int depth = 0;
         while (!at(Tok::end)) {
             const Tok k = cur().kind;
-            if (depth == 0 && (k == Tok::kw_fn || k == Tok::kw_const || k == Tok::kw_shape || k == Tok::kw_test ||
-                               k == Tok::kw_import || k == Tok::kw_print))
+            if (depth == 0 && (k == Tok::kw_fn || k == Tok::kw_const || k == Tok::kw_shape ||
+                               k == Tok::kw_test || k == Tok::kw_import || k == Tok::kw_print))
                 return;
             take();
             if (k == Tok::lbrace) ++depth;
@@ -233,8 +233,8 @@ private:
             const Location loc = take().loc;
             e = binary(k, loc, std::move(e), union_expr());
             const Tok again = cur().kind;
-            if (again == Tok::lt || again == Tok::le || again == Tok::gt || again == Tok::ge || again == Tok::eq ||
-                again == Tok::ne)
+            if (again == Tok::lt || again == Tok::le || again == Tok::gt || again == Tok::ge ||
+                again == Tok::eq || again == Tok::ne)
                 fail("comparisons do not chain; combine them with 'and'");
         }
         return e;
@@ -283,7 +283,8 @@ private:
     }
     ExprPtr unary_expr() {
         if (at(Tok::minus) || at(Tok::plus) || at(Tok::tilde)) {
-            if (++depth_ > max_nesting) fail(fmt::format("expression nested deeper than {} levels", max_nesting));
+            if (++depth_ > max_nesting)
+                fail(fmt::format("expression nested deeper than {} levels", max_nesting));
             const Tok k = cur().kind;
             auto e = make(ExprKind::unary, take().loc);
             e->op = k;
@@ -398,6 +399,8 @@ private:
 
 } // namespace
 
-Program parse(const std::vector<Token>& tokens, Diagnostics& diags) { return Parser(tokens, diags).program(); }
+Program parse(const std::vector<Token>& tokens, Diagnostics& diags) {
+    return Parser(tokens, diags).program();
+}
 
 } // namespace frac::front

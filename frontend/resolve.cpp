@@ -114,12 +114,12 @@ private:
             if (target.kind == ItemKind::const_) {
                 d_.error(e.loc, fmt::format("'{}' is a constant, not a function", e.text));
             } else if (target.kind == ItemKind::fn && n != static_cast<int>(target.params.size())) {
-                d_.error(e.loc, fmt::format("'{}' takes {} argument{}, {} given", e.text, target.params.size(),
-                                            target.params.size() == 1 ? "" : "s", n));
+                d_.error(e.loc, fmt::format("'{}' takes {} argument{}, {} given", e.text,
+                                            target.params.size(), target.params.size() == 1 ? "" : "s", n));
             } else if (target.kind == ItemKind::shape && target.has_params && n != 1 &&
                        n != static_cast<int>(target.params.size())) {
-                d_.error(e.loc, fmt::format("shape '{}' takes {} coordinates (or one point), {} given", e.text,
-                                            target.params.size(), n));
+                d_.error(e.loc, fmt::format("shape '{}' takes {} coordinates (or one point), {} given",
+                                            e.text, target.params.size(), n));
             }
             return;
         }
@@ -130,8 +130,8 @@ private:
         }
         if (n < b->min_args || n > b->max_args) {
             const std::string want = b->min_args == b->max_args ? fmt::format("{}", b->min_args)
-                                     : b->max_args >= 64    ? fmt::format("at least {}", b->min_args)
-                                                            : fmt::format("{} to {}", b->min_args, b->max_args);
+                                     : b->max_args >= 64        ? fmt::format("at least {}", b->min_args)
+                                                         : fmt::format("{} to {}", b->min_args, b->max_args);
             d_.error(e.loc, fmt::format("'{}' takes {} argument{}, {} given", e.text, want,
                                         b->max_args == 1 ? "" : "s", n));
         }
@@ -148,6 +148,8 @@ private:
 
 } // namespace
 
-void resolve_names(const Program& program, Diagnostics& diags) { Resolver(program, diags).run(); }
+void resolve_names(const Program& program, Diagnostics& diags) {
+    Resolver(program, diags).run();
+}
 
 } // namespace frac::front

@@ -65,7 +65,8 @@ private:
     // An enclosure of a value whose form has no B part and decay <= 1, independent of i.
     NodeId enclosure(const TermBound& f, const char* what) {
         if (f.b != no_node) throw Failure{fmt::format("the argument of {} grows with the index", what)};
-        if (f.gamma.hi > 1.0) throw Failure{fmt::format("the argument of {} grows exponentially with the index", what)};
+        if (f.gamma.hi > 1.0)
+            throw Failure{fmt::format("the argument of {} grows exponentially with the index", what)};
         if (f.gamma == Interval(1.0)) return f.a;
         return g_.op(Op::Mul, f.a, unit_interval()); // gamma^i in (0, 1]
     }
@@ -96,7 +97,8 @@ private:
         }
         case Op::Mul: {
             const TermBound x = arg(0), y = arg(1);
-            if (x.b != no_node && y.b != no_node) throw Failure{"a product of two factors that grow with the index grows faster than linearly"};
+            if (x.b != no_node && y.b != no_node)
+                throw Failure{"a product of two factors that grow with the index grows faster than linearly"};
             TermBound r;
             r.gamma = num::mul(x.gamma, y.gamma);
             r.a = g_.op(Op::Mul, x.a, y.a);
@@ -151,7 +153,8 @@ private:
             if (x.gamma == Interval(1.0)) {
                 // floor(v) in v + [-1, 0], ceil(v) in v + [0, 1]: linear forms stay linear.
                 TermBound r = x;
-                r.a = g_.op(Op::Add, x.a, konst(n.op == Op::Floor ? Interval{-1.0, 0.0} : Interval{0.0, 1.0}));
+                r.a =
+                    g_.op(Op::Add, x.a, konst(n.op == Op::Floor ? Interval{-1.0, 0.0} : Interval{0.0, 1.0}));
                 return r;
             }
             return index_free(g_.op(n.op, enclosure(x, n.op == Op::Floor ? "floor" : "ceil")));
@@ -204,10 +207,11 @@ std::optional<TermBound> bound_series_term(Graph& g, NodeId term, int level, std
         Bounder b(g, level);
         TermBound f = b.form(term);
         if (!(f.gamma.hi < 1.0) || !(f.gamma.lo > 0.0)) {
-            why = fmt::format("its terms do not decay geometrically (they are bounded only by (A + B i) * {}^i); "
-                              "divide the term by c^i with c > 1",
-                              f.gamma.is_thin() ? fmt::format("{}", f.gamma.lo)
-                                                : fmt::format("[{}, {}]", f.gamma.lo, f.gamma.hi));
+            why = fmt::format(
+                "its terms do not decay geometrically (they are bounded only by (A + B i) * {}^i); "
+                "divide the term by c^i with c > 1",
+                f.gamma.is_thin() ? fmt::format("{}", f.gamma.lo)
+                                  : fmt::format("[{}, {}]", f.gamma.lo, f.gamma.hi));
             return std::nullopt;
         }
         return f;

@@ -25,8 +25,8 @@ inline constexpr int max_terms_limit = 100000;
 
 // Counters an evaluator keeps (reset by the caller when it wants per-run numbers).
 struct EvalStats {
-    std::uint64_t calls = 0;        // point or box evaluations
-    std::uint64_t series_terms = 0; // series terms evaluated in total
+    std::uint64_t calls = 0;         // point or box evaluations
+    std::uint64_t series_terms = 0;  // series terms evaluated in total
     std::uint64_t series_capped = 0; // series stopped by the term limit, not by resolution
 };
 

@@ -23,15 +23,25 @@ constexpr OpInfo op_table[] = {
 #undef FRAC_OP
 };
 
-std::uint64_t bits(double v) { return std::bit_cast<std::uint64_t>(v); }
+std::uint64_t bits(double v) {
+    return std::bit_cast<std::uint64_t>(v);
+}
 
-void mix(std::size_t& h, std::uint64_t v) { h ^= std::hash<std::uint64_t>{}(v) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2); }
+void mix(std::size_t& h, std::uint64_t v) {
+    h ^= std::hash<std::uint64_t>{}(v) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+}
 
 } // namespace
 
-int arity(Op op) { return op_table[static_cast<int>(op)].arity; }
-const char* op_name(Op op) { return op_table[static_cast<int>(op)].name; }
-OpClass op_class(Op op) { return op_table[static_cast<int>(op)].cls; }
+int arity(Op op) {
+    return op_table[static_cast<int>(op)].arity;
+}
+const char* op_name(Op op) {
+    return op_table[static_cast<int>(op)].name;
+}
+OpClass op_class(Op op) {
+    return op_table[static_cast<int>(op)].cls;
+}
 
 std::size_t Graph::KeyHash::operator()(const Node& n) const {
     std::size_t h = static_cast<std::size_t>(n.op);

@@ -26,7 +26,9 @@ enum class OpClass : std::uint8_t { leaf, arith, logic, series };
 int arity(Op op);
 const char* op_name(Op op);
 OpClass op_class(Op op);
-inline bool is_series(Op op) { return op_class(op) == OpClass::series; }
+inline bool is_series(Op op) {
+    return op_class(op) == OpClass::series;
+}
 
 using NodeId = std::uint32_t;
 inline constexpr NodeId no_node = std::numeric_limits<NodeId>::max();
@@ -36,10 +38,10 @@ inline constexpr std::int64_t infinite_end = std::numeric_limits<std::int64_t>::
 // with A and B enclosed by evaluating the nodes tail_a / tail_b over the current box (B may be absent)
 // and 0 < gamma < 1. The frontend proves this form (frontend/series_bounds).
 struct SeriesData {
-    int level = 0;           // nesting level; the body reads the index with Index(level)
+    int level = 0; // nesting level; the body reads the index with Index(level)
     std::int64_t start = 0;
     std::int64_t end = infinite_end; // inclusive; infinite_end for an infinite series
-    Interval gamma{0.0, 0.0};         // decay, proven 0 < gamma.hi < 1 for infinite series
+    Interval gamma{0.0, 0.0};        // decay, proven 0 < gamma.hi < 1 for infinite series
     bool operator==(const SeriesData&) const = default;
 };
 

@@ -32,7 +32,8 @@ std::string print_graph(const Graph& g, const std::vector<NodeId>& roots) {
             break;
         case OpClass::arith:
         case OpClass::logic:
-            for (int i = 0; i < arity(n.op); ++i) out += fmt::format("{} %{}", i ? "," : "", n.args[static_cast<std::size_t>(i)]);
+            for (int i = 0; i < arity(n.op); ++i)
+                out += fmt::format("{} %{}", i ? "," : "", n.args[static_cast<std::size_t>(i)]);
             if (n.op == Op::PowI) out += fmt::format(", {}", n.imm);
             break;
         case OpClass::series: {

@@ -18,8 +18,9 @@ Interval series_tail(Op kind, Interval a, Interval b, bool has_b, Interval gamma
     const Interval s0 = div(g1, one_minus); // sum_{i>n} gamma^i
     // sum_{i>n} i gamma^i = gamma^(n+1) ((n+1) - n gamma) / (1 - gamma)^2
     const auto nd = static_cast<double>(n);
-    const Interval s1 = has_b ? div(mul(g1, sub(Interval(nd + 1.0), mul(Interval(nd), gamma))), sqr(one_minus))
-                              : Interval(0.0);
+    const Interval s1 = has_b
+                            ? div(mul(g1, sub(Interval(nd + 1.0), mul(Interval(nd), gamma))), sqr(one_minus))
+                            : Interval(0.0);
     switch (kind) {
     case Op::SeriesSum: return has_b ? add(mul(a, s0), mul(b, s1)) : mul(a, s0);
     case Op::SeriesMin: {
@@ -28,7 +29,8 @@ Interval series_tail(Op kind, Interval a, Interval b, bool has_b, Interval gamma
         if (!has_b) {
             lo = std::fmin(0.0, mul(a, g1).lo); // gamma^i decreases: the first tail term is the lowest
         } else {
-            const Interval neg_part = add(mul(Interval(std::fmax(0.0, -a.lo)), s0), mul(Interval(std::fmax(0.0, -b.lo)), s1));
+            const Interval neg_part =
+                add(mul(Interval(std::fmax(0.0, -a.lo)), s0), mul(Interval(std::fmax(0.0, -b.lo)), s1));
             lo = std::fmin(0.0, -neg_part.hi);
         }
         return {lo, std::fmin(0.0, first.hi)};
@@ -39,7 +41,8 @@ Interval series_tail(Op kind, Interval a, Interval b, bool has_b, Interval gamma
         if (!has_b) {
             hi = std::fmax(0.0, mul(a, g1).hi);
         } else {
-            const Interval pos_part = add(mul(Interval(std::fmax(0.0, a.hi)), s0), mul(Interval(std::fmax(0.0, b.hi)), s1));
+            const Interval pos_part =
+                add(mul(Interval(std::fmax(0.0, a.hi)), s0), mul(Interval(std::fmax(0.0, b.hi)), s1));
             hi = std::fmax(0.0, pos_part.hi);
         }
         return {std::fmax(0.0, first.lo), hi};

@@ -9,7 +9,9 @@ namespace frac::ir {
 
 namespace {
 
-int highest_level(std::uint64_t mask) { return mask == 0 ? 0 : 63 - std::countl_zero(mask); }
+int highest_level(std::uint64_t mask) {
+    return mask == 0 ? 0 : 63 - std::countl_zero(mask);
+}
 
 class Scheduler {
 public:
@@ -71,7 +73,8 @@ private:
         Instr ins;
         ins.op = n.op;
         ins.imm = n.imm;
-        for (int i = 0; i < arity(n.op); ++i) ins.in[static_cast<std::size_t>(i)] = emit(n.args[static_cast<std::size_t>(i)]);
+        for (int i = 0; i < arity(n.op); ++i)
+            ins.in[static_cast<std::size_t>(i)] = emit(n.args[static_cast<std::size_t>(i)]);
         ins.out = fresh();
         t_.blocks[block].push_back(ins);
         return ins.out;
@@ -132,7 +135,9 @@ Tape build_tape(const Graph& g, NodeId root, int inputs) {
 
 namespace {
 
-std::string slot_name(Slot s) { return s == no_slot ? "-" : fmt::format("%{}", s); }
+std::string slot_name(Slot s) {
+    return s == no_slot ? "-" : fmt::format("%{}", s);
+}
 
 std::string interval_text(Interval v) {
     return v.is_thin() ? fmt::format("{}", v.lo) : fmt::format("[{}, {}]", v.lo, v.hi);
@@ -155,7 +160,8 @@ void print_block(const Tape& t, std::uint32_t b, int indent, std::string& out) {
             continue;
         }
         out += fmt::format("{}{} = {}", pad, slot_name(ins.out), op_name(ins.op));
-        for (int i = 0; i < arity(ins.op); ++i) out += fmt::format("{} {}", i ? "," : "", slot_name(ins.in[static_cast<std::size_t>(i)]));
+        for (int i = 0; i < arity(ins.op); ++i)
+            out += fmt::format("{} {}", i ? "," : "", slot_name(ins.in[static_cast<std::size_t>(i)]));
         if (ins.op == Op::PowI) out += fmt::format(", {}", ins.imm);
         out += "\n";
     }
@@ -167,8 +173,10 @@ std::string print_tape(const Tape& t) {
     std::string out = fmt::format("tape: {} inputs, {} slots, {} instructions\n", t.inputs, t.num_slots,
                                   t.instruction_count());
     for (std::size_t k = 0; k < t.input_slots.size(); ++k)
-        if (t.input_slots[k] != no_slot) out += fmt::format("{} = input {}\n", slot_name(t.input_slots[k]), k);
-    for (const TapeConst& c : t.constants) out += fmt::format("{} = const {}\n", slot_name(c.slot), interval_text(c.value));
+        if (t.input_slots[k] != no_slot)
+            out += fmt::format("{} = input {}\n", slot_name(t.input_slots[k]), k);
+    for (const TapeConst& c : t.constants)
+        out += fmt::format("{} = const {}\n", slot_name(c.slot), interval_text(c.value));
     print_block(t, 0, 0, out);
     out += fmt::format("result {}\n", slot_name(t.result));
     return out;
@@ -182,20 +190,24 @@ std::string verify_block(const Tape& t, std::uint32_t b, std::vector<bool>& writ
         for (int i = 0; i < k; ++i) {
             const Slot s = ins.in[static_cast<std::size_t>(i)];
             if (s >= t.num_slots || !written[s])
-                return fmt::format("block {}: {} reads {} before it is written", b, op_name(ins.op), slot_name(s));
+                return fmt::format("block {}: {} reads {} before it is written", b, op_name(ins.op),
+                                   slot_name(s));
         }
         if (is_series(ins.op)) {
             if (ins.series >= t.series.size()) return fmt::format("block {}: bad series index", b);
             const TapeSeries& s = t.series[ins.series];
-            if (s.block <= b || s.block >= t.blocks.size()) return fmt::format("series block {} out of order", s.block);
+            if (s.block <= b || s.block >= t.blocks.size())
+                return fmt::format("series block {} out of order", s.block);
             if (s.index_slot >= t.num_slots) return "series index slot out of range";
             written[s.index_slot] = true;
             if (auto e = verify_block(t, s.block, written); !e.empty()) return e;
             if (s.body_slot >= t.num_slots || !written[s.body_slot]) return "series term slot not written";
             if (s.data.end == infinite_end) {
-                if (s.tail_a == no_slot || !written[s.tail_a]) return "infinite series without tail coefficient";
+                if (s.tail_a == no_slot || !written[s.tail_a])
+                    return "infinite series without tail coefficient";
                 if (s.tail_b != no_slot && !written[s.tail_b]) return "series tail coefficient not written";
-                if (!(s.data.gamma.lo > 0 && s.data.gamma.hi < 1)) return "infinite series without decay in (0, 1)";
+                if (!(s.data.gamma.lo > 0 && s.data.gamma.hi < 1))
+                    return "infinite series without decay in (0, 1)";
             }
         }
         if (ins.out >= t.num_slots || written[ins.out])

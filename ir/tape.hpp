@@ -37,7 +37,7 @@ struct TapeConst {
 };
 
 struct Tape {
-    int inputs = 0;                  // number of Var inputs (coordinates)
+    int inputs = 0; // number of Var inputs (coordinates)
     Slot num_slots = 0;
     std::vector<TapeConst> constants; // preloaded slots
     std::vector<Slot> input_slots;    // slot of input k, or no_slot when unused

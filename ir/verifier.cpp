@@ -11,7 +11,8 @@ std::string verify_graph(const Graph& g) {
         const int want = is_series(n.op) ? 1 : arity(n.op);
         for (int i = 0; i < 3; ++i) {
             const NodeId a = n.args[static_cast<std::size_t>(i)];
-            if (i < want && a == no_node) return fmt::format("%{}: {} lacks argument {}", id, op_name(n.op), i);
+            if (i < want && a == no_node)
+                return fmt::format("%{}: {} lacks argument {}", id, op_name(n.op), i);
             if (!is_series(n.op) && i >= want && a != no_node)
                 return fmt::format("%{}: {} has too many arguments", id, op_name(n.op));
             if (a != no_node && a >= id) return fmt::format("%{}: argument %{} is not earlier", id, a);

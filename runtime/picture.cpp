@@ -155,7 +155,7 @@ std::string num_text(double v, int decimals) {
 
 // Writes an SVG incrementally so that a large cover never sits in memory twice.
 class SvgWriter {
-  public:
+public:
     explicit SvgWriter(const std::string& path) : path_(path), os_(path, std::ios::binary | std::ios::trunc) {
         if (!os_)
             throw std::runtime_error(fmt::format("cannot write SVG '{}': {}", path, std::strerror(errno)));
@@ -170,7 +170,7 @@ class SvgWriter {
         if (!os_) throw std::runtime_error(fmt::format("cannot write SVG '{}': write failed", path_));
     }
 
-  private:
+private:
     void flush() {
         os_.write(buf_.data(), static_cast<std::streamsize>(buf_.size()));
         buf_.clear();

@@ -90,7 +90,7 @@ void validate(const ir::Evaluator& f, const std::vector<Interval>& root, const R
 // One run of the subdivision. Holds the frontier of the current level (its undecided cells) and
 // the batch being filled, nothing else unless keep_cells.
 class Runner {
-  public:
+public:
     Runner(ir::Evaluator& f, RssResult& r) : f_(f), r_(r), d_(r.dimension()) {
         num::UpwardRounding up;
         for (const Interval& x : r_.root) width_.push_back(axis_width(x));
@@ -120,7 +120,7 @@ class Runner {
         r_.subdivided = r_.evaluated - r_.inside - r_.outside - r_.boundary;
     }
 
-  private:
+private:
     void start_level(int k) {
         level_ = k;
         n_ = ipow(r_.options.split, k);

@@ -30,7 +30,9 @@ public:
 
     int dimension() const override { return tape_.inputs; }
     std::string engine() const override { return "interp"; }
-    std::unique_ptr<ir::Evaluator> clone() const override { return std::make_unique<Interpreter>(tape_, options_); }
+    std::unique_ptr<ir::Evaluator> clone() const override {
+        return std::make_unique<Interpreter>(tape_, options_);
+    }
 
     double eval_point(const double* coords) override {
         ++stats.calls;
@@ -84,7 +86,8 @@ private:
                 points_[ins.out] = series_point(tape_.series[ins.series]);
                 continue;
             }
-            for (int i = 0; i < ir::arity(ins.op); ++i) args[i] = points_[ins.in[static_cast<std::size_t>(i)]];
+            for (int i = 0; i < ir::arity(ins.op); ++i)
+                args[i] = points_[ins.in[static_cast<std::size_t>(i)]];
             points_[ins.out] = ir::apply_point(ins.op, args, ins.imm);
         }
     }
@@ -166,8 +169,9 @@ private:
         Interval tail;
         {
             num::UpwardRounding up;
-            tail = ir::series_tail(s.kind, Interval(points_[s.tail_a]),
-                                   has_b ? Interval(points_[s.tail_b]) : Interval(0.0), has_b, s.data.gamma, i);
+            tail =
+                ir::series_tail(s.kind, Interval(points_[s.tail_a]),
+                                has_b ? Interval(points_[s.tail_b]) : Interval(0.0), has_b, s.data.gamma, i);
         }
         return ir::series_combine_point(s.kind, acc, num::midpoint(tail));
     }

@@ -60,12 +60,19 @@ int main(int argc, char** argv) {
         const auto pos = line.find("// ");
         if (pos == std::string::npos) continue;
         const std::string d = line.substr(pos + 3);
-        auto value = [&](const std::string& key) { return d.rfind(key, 0) == 0 ? d.substr(key.size()) : std::string(); };
-        if (d.rfind("args:", 0) == 0) args = trim(value("args:"));
-        else if (d.rfind("expect error:", 0) == 0) want_errors.push_back(trim(value("expect error:")));
-        else if (d.rfind("expect stderr:", 0) == 0) want_stderr.push_back(trim(value("expect stderr:")));
-        else if (d.rfind("expect exit:", 0) == 0) want_exit = std::atoi(value("expect exit:").c_str());
-        else if (d.rfind("expect:", 0) == 0) want_out.push_back(value("expect:").substr(d.size() > 7 && d[7] == ' ' ? 1 : 0));
+        auto value = [&](const std::string& key) {
+            return d.rfind(key, 0) == 0 ? d.substr(key.size()) : std::string();
+        };
+        if (d.rfind("args:", 0) == 0)
+            args = trim(value("args:"));
+        else if (d.rfind("expect error:", 0) == 0)
+            want_errors.push_back(trim(value("expect error:")));
+        else if (d.rfind("expect stderr:", 0) == 0)
+            want_stderr.push_back(trim(value("expect stderr:")));
+        else if (d.rfind("expect exit:", 0) == 0)
+            want_exit = std::atoi(value("expect exit:").c_str());
+        else if (d.rfind("expect:", 0) == 0)
+            want_out.push_back(value("expect:").substr(d.size() > 7 && d[7] == ' ' ? 1 : 0));
     }
     if (want_exit < 0) want_exit = want_errors.empty() ? 0 : 65;
 
@@ -76,7 +83,8 @@ int main(int argc, char** argv) {
     close(fe);
     const std::string sub = args.substr(0, args.find(' '));
     const std::string rest = args.find(' ') == std::string::npos ? "" : args.substr(args.find(' '));
-    const std::string cmd = quote(frac) + " " + sub + " " + quote(file) + rest + " >" + out_path + " 2>" + err_path + " </dev/null";
+    const std::string cmd = quote(frac) + " " + sub + " " + quote(file) + rest + " >" + out_path + " 2>" +
+                            err_path + " </dev/null";
     const int status = std::system(cmd.c_str());
     const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     const auto out = lines(read(out_path)), err = lines(read(err_path));
@@ -88,22 +96,27 @@ int main(int argc, char** argv) {
         ++failures;
         std::cerr << file << ": " << what << "\n";
     };
-    if (code != want_exit) fail("exit status " + std::to_string(code) + ", expected " + std::to_string(want_exit));
+    if (code != want_exit)
+        fail("exit status " + std::to_string(code) + ", expected " + std::to_string(want_exit));
     for (std::size_t i = 0; i < std::max(out.size(), want_out.size()); ++i) {
         const std::string got = i < out.size() ? out[i] : "<nothing>";
         const std::string want = i < want_out.size() ? want_out[i] : "<nothing>";
-        if (got != want) fail("stdout line " + std::to_string(i + 1) + ": got '" + got + "', expected '" + want + "'");
+        if (got != want)
+            fail("stdout line " + std::to_string(i + 1) + ": got '" + got + "', expected '" + want + "'");
     }
     std::size_t error_lines = 0;
     for (const std::string& l : err)
         if (l.find(": error: ") != std::string::npos && l.rfind("frac: error:", 0) != 0) ++error_lines;
     for (const std::string& w : want_errors) {
         bool found = false;
-        for (const std::string& l : err) found = found || l.find(":" + w.substr(0, w.find(": ")) + ": error: " + w.substr(w.find(": ") + 2)) != std::string::npos;
+        for (const std::string& l : err)
+            found = found || l.find(":" + w.substr(0, w.find(": ")) +
+                                    ": error: " + w.substr(w.find(": ") + 2)) != std::string::npos;
         if (!found) fail("missing diagnostic '" + w + "'");
     }
     if (error_lines != want_errors.size())
-        fail(std::to_string(error_lines) + " diagnostics on stderr, " + std::to_string(want_errors.size()) + " expected");
+        fail(std::to_string(error_lines) + " diagnostics on stderr, " + std::to_string(want_errors.size()) +
+             " expected");
     for (const std::string& w : want_stderr) {
         bool found = false;
         for (const std::string& l : err) found = found || l.find(w) != std::string::npos;

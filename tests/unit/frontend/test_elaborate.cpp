@@ -46,7 +46,8 @@ TEST_CASE("constants fold to outward enclosures", "[elaborate]") {
 }
 
 TEST_CASE("the default box and dimension of shapes", "[elaborate]") {
-    auto c = compile_ok("shape a = x + y;\nshape b over [0, 1] × [0, 1] × [-1, 1] = x + y + z;\nshape c(u, v) over [2, 3] × [4, 5] = u;");
+    auto c = compile_ok("shape a = x + y;\nshape b over [0, 1] × [0, 1] × [-1, 1] = x + y + z;\nshape c(u, "
+                        "v) over [2, 3] × [4, 5] = u;");
     CHECK(c->module.find_shape("a")->dimension == 2);
     CHECK(c->module.find_shape("a")->box.size() == 2);
     CHECK(c->module.find_shape("b")->dimension == 3);
@@ -78,21 +79,27 @@ TEST_CASE("series bounds: the carpet decays like 3^-i with a bounded kernel", "[
 }
 
 TEST_CASE("series that cannot be bounded are compile errors that say why", "[series]") {
-    CHECK(errors_of("shape s(x, y) = sum(i in 0.., i * x);").find("do not decay geometrically") != std::string::npos);
-    CHECK(errors_of("shape s(x, y) = sum(i in 0.., 2^i);").find("do not decay geometrically") != std::string::npos);
-    CHECK(errors_of("shape s(x, y) = sum(i in 0.., i * i / 2^i);").find("faster than linearly") != std::string::npos);
-    CHECK(errors_of("shape s(x, y) = sum(i in 0.., x^i);").find("positive constant base") != std::string::npos);
+    CHECK(errors_of("shape s(x, y) = sum(i in 0.., i * x);").find("do not decay geometrically") !=
+          std::string::npos);
+    CHECK(errors_of("shape s(x, y) = sum(i in 0.., 2^i);").find("do not decay geometrically") !=
+          std::string::npos);
+    CHECK(errors_of("shape s(x, y) = sum(i in 0.., i * i / 2^i);").find("faster than linearly") !=
+          std::string::npos);
+    CHECK(errors_of("shape s(x, y) = sum(i in 0.., x^i);").find("positive constant base") !=
+          std::string::npos);
     CHECK(errors_of("shape s(x, y) = sum(i in -1.., 1 / 2^i);").find("index >= 0") != std::string::npos);
 }
 
 TEST_CASE("series bounds see through CSG and if", "[series]") {
-    auto c = compile_ok("shape s(x, y) = sum(i in 0.., if dz(2^i * x) < 0.25 then 1 / 2^i else max(dz(x), 0.5) / 4^i);");
+    auto c = compile_ok(
+        "shape s(x, y) = sum(i in 0.., if dz(2^i * x) < 0.25 then 1 / 2^i else max(dz(x), 0.5) / 4^i);");
     const ir::Node& series = c->module.graph[c->module.find_shape("s")->root];
     CHECK(series.series.gamma == ir::Interval(0.5));
 }
 
 TEST_CASE("nested series and loop-invariant hoisting", "[series][tape]") {
-    auto c = compile_ok("shape s(x, y) = sum(i in 0.., sum(j in 0.., dz(2^j * x) / 2^j) / 3^i + dz(y) / 3^i);");
+    auto c =
+        compile_ok("shape s(x, y) = sum(i in 0.., sum(j in 0.., dz(2^j * x) / 2^j) / 3^i + dz(y) / 3^i);");
     const ShapeInfo* s = c->module.find_shape("s");
     const ir::Tape t = ir::build_tape(c->module.graph, s->root, 2);
     REQUIRE(ir::verify_tape(t).empty());
@@ -105,7 +112,8 @@ TEST_CASE("nested series and loop-invariant hoisting", "[series][tape]") {
 }
 
 TEST_CASE("type errors are reported at the offending expression", "[elaborate]") {
-    const std::string e = errors_of("shape s(x, y) = (x, y) * (x, y);\nfn f(p) = p.x;\nshape t(x, y) = f(1);");
+    const std::string e =
+        errors_of("shape s(x, y) = (x, y) * (x, y);\nfn f(p) = p.x;\nshape t(x, y) = f(1);");
     CHECK(e.find("t.frac:1:24: error: points multiply or divide by numbers only") != std::string::npos);
     CHECK(e.find("t.frac:2:12: error: '.x' needs a point, found a number") != std::string::npos);
 }

@@ -9,8 +9,10 @@ namespace {
 
 std::string ast_of(const std::string& text, std::string* errors = nullptr) {
     auto c = compile_source("t.frac", text, {}, StopAfter::parse);
-    if (errors) *errors = c->diags.render(c->sources);
-    else if (!c->ok()) FAIL(c->diags.render(c->sources));
+    if (errors)
+        *errors = c->diags.render(c->sources);
+    else if (!c->ok())
+        FAIL(c->diags.render(c->sources));
     return print_ast(c->program, 1);
 }
 
@@ -40,7 +42,8 @@ TEST_CASE("every grammar production parses", "[grammar]") {
          "(const c (or (and (not (< 1 2)) (< 2 3)) (== 1 1)))\n"},
         {"comparison ops", "const c = 1 <= 2 and 2 != 0 and 1 >= 0 and 2 > 1 and 0 == 0;", ""},
         {"union/intersection", "const c = 1 | 2 & 3;", "(const c (| 1 (& 2 3)))\n"},
-        {"box", "const c = [0, 1] × [2, 3] × [4, 5];", "(const c (× (× (interval 0 1) (interval 2 3)) (interval 4 5)))\n"},
+        {"box", "const c = [0, 1] × [2, 3] × [4, 5];",
+         "(const c (× (× (interval 0 1) (interval 2 3)) (interval 4 5)))\n"},
         {"sum/product", "const c = 1 + 2 * 3 - 4 / 5;", "(const c (- (+ 1 (* 2 3)) (/ 4 5)))\n"},
         {"unary", "const c = -~+1;", "(const c (- (~ (+ 1))))\n"},
         {"power", "const c = -2^3^-1;", "(const c (- (^ 2 (^ 3 (- 1)))))\n"},
@@ -49,7 +52,8 @@ TEST_CASE("every grammar production parses", "[grammar]") {
         {"primary: parenthesis", "const c = (1 + 2) * 3;", "(const c (* (+ 1 2) 3))\n"},
         {"primary: point", "const c = (1, 2, 3);", "(const c (point 1 2 3))\n"},
         {"primary: interval", "const c = [1, 2];", "(const c (interval 1 2))\n"},
-        {"call/argument", "const c = dimension(s, from: 4, to: 9);", "(const c (call dimension s from: 4 to: 9))\n"},
+        {"call/argument", "const c = dimension(s, from: 4, to: 9);",
+         "(const c (call dimension s from: 4 to: 9))\n"},
         {"series infinite", "fn f(x) = sum(i in 0.., x / 2^i);", "(fn f (x) (sum i 0 inf (/ x (^ 2 i))))\n"},
         {"series finite", "fn f(x) = min(k in 1..5, x);", "(fn f (x) (min k 1 5 x))\n"},
         {"max call is not a series", "fn f(x) = max(x, 1);", "(fn f (x) (call max x 1))\n"},
@@ -70,7 +74,8 @@ TEST_CASE("syntax errors are located and the parser recovers", "[parser]") {
     std::string errors;
     ast_of("fn f(x) = x +;\nshape s(x, y) = (x;\nconst ok = 1;\nconst c = 1 < 2 < 3;\n", &errors);
     CHECK(errors.find("t.frac:1:14: error: expected an expression, found ';'") != std::string::npos);
-    CHECK(errors.find("t.frac:2:19: error: expected ')' to close the parenthesis, found ';'") != std::string::npos);
+    CHECK(errors.find("t.frac:2:19: error: expected ')' to close the parenthesis, found ';'") !=
+          std::string::npos);
     CHECK(errors.find("t.frac:4:17: error: comparisons do not chain") != std::string::npos);
     // The source line and a caret under the column.
     CHECK(errors.find("  fn f(x) = x +;\n               ^\n") != std::string::npos);

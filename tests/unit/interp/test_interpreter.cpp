@@ -20,7 +20,8 @@ Shape shape(const std::string& text, const std::string& name = "s", ir::EvalOpti
     if (!s.c->ok()) FAIL(s.c->diags.render(s.c->sources));
     const front::ShapeInfo* info = s.c->module.find_shape(name);
     REQUIRE(info);
-    s.eval = interp::make_interpreter(ir::build_tape(s.c->module.graph, info->root, info->dimension), options);
+    s.eval =
+        interp::make_interpreter(ir::build_tape(s.c->module.graph, info->root, info->dimension), options);
     return s;
 }
 
@@ -68,16 +69,17 @@ TEST_CASE("wide boxes are not charged for terms they cannot resolve", "[interp][
     s.eval->stats = {};
     box_eval(*s.eval, {0.1, 0.1 + 1e-9}, {0.2, 0.2 + 1e-9});
     const auto narrow_terms = s.eval->stats.series_terms;
-    CHECK(wide_terms <= 6);   // 3^i / 64 >= 1 from i = 4 on
+    CHECK(wide_terms <= 6); // 3^i / 64 >= 1 from i = 4 on
     CHECK(narrow_terms > wide_terms);
     CHECK(s.eval->stats.series_capped == 0);
 }
 
 TEST_CASE("the carpet: holes are proven inside, the carpet is never proven", "[interp][series]") {
     auto s = shape("shape s(x, y) = min(i in 0.., (1/3 - min(dz(3^i * x), dz(3^i * y))) / 3^i);");
-    CHECK(box_eval(*s.eval, {0.4, 0.6}, {0.4, 0.6}).hi < 0);          // central hole
-    CHECK(box_eval(*s.eval, {0.13, 0.2}, {0.13, 0.2}).hi < 0);        // a second-level hole
-    const ir::Interval on = box_eval(*s.eval, {0.0, 0.01}, {0.0, 0.01}); // contains the corner (on the carpet)
+    CHECK(box_eval(*s.eval, {0.4, 0.6}, {0.4, 0.6}).hi < 0);   // central hole
+    CHECK(box_eval(*s.eval, {0.13, 0.2}, {0.13, 0.2}).hi < 0); // a second-level hole
+    const ir::Interval on =
+        box_eval(*s.eval, {0.0, 0.01}, {0.0, 0.01}); // contains the corner (on the carpet)
     CHECK(on.lo < 0);
     CHECK(on.hi >= 0);
 }
@@ -122,7 +124,8 @@ TEST_CASE("batches give the same results as single calls", "[interp]") {
     }
     std::vector<ir::Interval> out(20);
     s.eval->eval_boxes(boxes.data(), 20, out.data());
-    for (int i = 0; i < 20; ++i) CHECK(out[static_cast<std::size_t>(i)] == s.eval->eval_box(&boxes[2 * static_cast<std::size_t>(i)]));
+    for (int i = 0; i < 20; ++i)
+        CHECK(out[static_cast<std::size_t>(i)] == s.eval->eval_box(&boxes[2 * static_cast<std::size_t>(i)]));
     auto copy = s.eval->clone();
     CHECK(copy->eval_box(boxes.data()) == out[0]);
 }

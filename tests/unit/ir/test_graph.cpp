@@ -29,7 +29,9 @@ TEST_CASE("constant folding gives outward enclosures and point values", "[graph]
 }
 
 TEST_CASE("every opcode has a name and an arity", "[graph]") {
-#define FRAC_OP(name, ar, text, cls) CHECK(std::string(op_name(Op::name)) == text); CHECK(arity(Op::name) == ar);
+#define FRAC_OP(name, ar, text, cls)                                                                         \
+    CHECK(std::string(op_name(Op::name)) == text);                                                           \
+    CHECK(arity(Op::name) == ar);
 #include "ir/opcodes.def"
 #undef FRAC_OP
 }
@@ -37,8 +39,9 @@ TEST_CASE("every opcode has a name and an arity", "[graph]") {
 TEST_CASE("index masks and series levels", "[graph]") {
     Graph g;
     const NodeId i = g.index(1);
-    const NodeId term = g.op(Op::Div, g.op(Op::Dz, g.op(Op::Mul, g.op(Op::Pow, g.constant(2.0), i), g.var(0))),
-                             g.op(Op::Pow, g.constant(2.0), i));
+    const NodeId term =
+        g.op(Op::Div, g.op(Op::Dz, g.op(Op::Mul, g.op(Op::Pow, g.constant(2.0), i), g.var(0))),
+             g.op(Op::Pow, g.constant(2.0), i));
     CHECK(g[term].index_mask == 2u);
     SeriesData d;
     d.level = 1;

@@ -17,7 +17,7 @@ using num::Interval;
 
 // Common part: records how the batch API is used.
 class TestShape : public ir::Evaluator {
-  public:
+public:
     explicit TestShape(int dim) : dim_(dim) {}
     int dimension() const override { return dim_; }
     std::string engine() const override { return "test"; }
@@ -29,13 +29,13 @@ class TestShape : public ir::Evaluator {
 
     std::size_t batches = 0, max_batch = 0;
 
-  private:
+private:
     int dim_;
 };
 
 // (x-cx)^2 + (y-cy)^2 - r^2: sqr and + of independent variables give the exact range, up to rounding.
 class Disk : public TestShape {
-  public:
+public:
     Disk(double cx, double cy, double r) : TestShape(2), cx(cx), cy(cy), r(r) {}
     double eval_point(const double* p) override {
         const double dx = p[0] - cx, dy = p[1] - cy;
@@ -53,7 +53,7 @@ class Disk : public TestShape {
 
 // x^2 + y^2 + z^2 - r^2.
 class Ball : public TestShape {
-  public:
+public:
     explicit Ball(double r) : TestShape(3), r(r) {}
     double eval_point(const double* p) override { return p[0] * p[0] + p[1] * p[1] + p[2] * p[2] - r * r; }
     Interval eval_box(const Interval* b) override {
@@ -68,7 +68,7 @@ class Ball : public TestShape {
 
 // a*x + b*y + c: inside where negative.
 class HalfPlane : public TestShape {
-  public:
+public:
     HalfPlane(double a, double b, double c) : TestShape(2), a(a), b(b), c(c) {}
     double eval_point(const double* p) override { return a * p[0] + b * p[1] + c; }
     Interval eval_box(const Interval* box) override {
@@ -82,7 +82,7 @@ class HalfPlane : public TestShape {
 
 // 1/4 - dz(freq * x): vertical stripes, inside where freq*x is within 1/4 of a half-integer.
 class Stripes : public TestShape {
-  public:
+public:
     explicit Stripes(double freq) : TestShape(2), freq(freq) {}
     double eval_point(const double* p) override { return 0.25 - num::point::dz(freq * p[0]); }
     Interval eval_box(const Interval* b) override {
@@ -96,7 +96,7 @@ class Stripes : public TestShape {
 
 // Undefined (empty enclosure) where x < 0 on the whole box, else x - 1/2.
 class HalfDefined : public TestShape {
-  public:
+public:
     HalfDefined() : TestShape(2) {}
     double eval_point(const double* p) override {
         return p[0] < 0 ? std::numeric_limits<double>::quiet_NaN() : p[0] - 0.5;
@@ -111,7 +111,7 @@ class HalfDefined : public TestShape {
 
 // A misbehaving backend: a NaN bound everywhere. Every cell must stay undecided.
 class NanShape : public TestShape {
-  public:
+public:
     explicit NanShape(int dim) : TestShape(dim) {}
     double eval_point(const double*) override { return std::numeric_limits<double>::quiet_NaN(); }
     Interval eval_box(const Interval*) override { return {std::numeric_limits<double>::quiet_NaN(), 1.0}; }
@@ -120,7 +120,7 @@ class NanShape : public TestShape {
 
 // f = value everywhere.
 class Constant : public TestShape {
-  public:
+public:
     Constant(int dim, double value) : TestShape(dim), value(value) {}
     double eval_point(const double*) override { return value; }
     Interval eval_box(const Interval*) override { return Interval(value); }
