@@ -21,7 +21,8 @@ enum class ExprKind {
     tuple,    // kids: components (a point)
     field,    // text: component name (x, y, z); kids[0]
     interval, // kids: lo, hi
-    series,   // text: sum | min | max; var; kids: start, end (null if infinite), body
+    series,   // text: sum | min | max; var; kids: start, end (null if infinite), body,
+              // and for an orbit series (orbit_var in orbit(kids[3], orbit_map)) the initial point
 };
 
 struct Expr;
@@ -43,7 +44,9 @@ struct Expr {
     ExprKind kind;
     Location loc;
     std::string text;
-    std::string var;   // series index name
+    std::string var;                  // series index name
+    std::string orbit_var, orbit_map; // orbit series: the point's name and the map (a function)
+    Location orbit_loc;
     Tok op = Tok::end; // unary / binary operator
     std::vector<ExprPtr> kids;
     std::vector<Arg> args;

@@ -601,18 +601,42 @@ private:
                 --frames[frame].level;
             }
         } restore{frames_, frame};
+        std::vector<NodeId> orbit; // initial point, then the map applied to the state
+        if (!e.orbit_var.empty()) {
+            // The initial point is outside the series (the index is not visible to it).
+            frames_[frame].scopes.pop_back();
+            const Value init = expr(*e.kids[3]);
+            frames_[frame].scopes.emplace_back();
+            frames_[frame].scopes.back().emplace_back(e.var, Value::scalar(g_.index(data.level)));
+            if (init.kind != ValueKind::point)
+                fail(e.kids[3]->loc,
+                     fmt::format("an orbit starts at a point, found {}", kind_name(init.kind)));
+            data.state_count = static_cast<int>(init.nodes.size());
+            Value state;
+            state.kind = ValueKind::point;
+            for (int c = 0; c < data.state_count; ++c) state.nodes.push_back(g_.state(data.level, c));
+            const Item& map = *globals_.at(e.orbit_map);
+            const Value next =
+                inline_body(map, {{map.params[0].name, state}}, e.orbit_loc, frames_.back().ctx);
+            if (next.kind != ValueKind::point || next.nodes.size() != state.nodes.size())
+                fail(e.orbit_loc, fmt::format("the map '{}' must return a point of {} coordinates",
+                                              e.orbit_map, state.nodes.size()));
+            frames_[frame].scopes.back().emplace_back(e.orbit_var, state);
+            orbit = init.nodes;
+            orbit.insert(orbit.end(), next.nodes.begin(), next.nodes.end());
+        }
         const NodeId body = scalar(expr(*e.kids[2]), e.kids[2]->loc);
         const Op kind = e.text == "sum" ? Op::SeriesSum : e.text == "min" ? Op::SeriesMin : Op::SeriesMax;
-        if (!infinite) return Value::scalar(g_.series(kind, data, body, ir::no_node, ir::no_node));
+        if (!infinite) return Value::scalar(g_.series(kind, data, body, ir::no_node, ir::no_node, orbit));
         std::string why;
         std::optional<TermBound> bound;
         {
             num::UpwardRounding up;
-            bound = bound_series_term(g_, body, data.level, why);
+            bound = bound_series_term(g_, body, data.level, kind, why);
         }
         if (!bound) fail(e.loc, "cannot bound this infinite series: " + why);
         data.gamma = bound->gamma;
-        return Value::scalar(g_.series(kind, data, body, bound->a, bound->b));
+        return Value::scalar(g_.series(kind, data, body, bound->a, bound->b, orbit));
     }
 
     struct Frame {

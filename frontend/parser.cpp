@@ -385,7 +385,24 @@ private:
         expect(Tok::dotdot, "in the index range");
         e->kids.push_back(at(Tok::comma) ? nullptr : add_expr());
         expect(Tok::comma, "after the index range");
-        e->kids.push_back(expr());
+        // An orbit: p in orbit(p0, M) walks p_k = M(p_{k-1}) along with the index.
+        if (at(Tok::ident) && ahead(1).kind == Tok::kw_in && ahead(2).kind == Tok::ident &&
+            ahead(2).text == "orbit" && ahead(3).kind == Tok::lparen) {
+            e->orbit_loc = cur().loc;
+            e->orbit_var = take().text;
+            take();
+            take();
+            take();
+            ExprPtr init = expr();
+            expect(Tok::comma, "after the orbit's initial point");
+            e->orbit_map = expect(Tok::ident, "(the map of the orbit)").text;
+            expect(Tok::rparen, "to close the orbit");
+            expect(Tok::comma, "after the orbit");
+            e->kids.push_back(expr());
+            e->kids.push_back(std::move(init));
+        } else {
+            e->kids.push_back(expr());
+        }
         expect(Tok::rparen, "to close the series");
         return e;
     }

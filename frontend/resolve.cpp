@@ -84,8 +84,21 @@ private:
         case ExprKind::series: {
             expr(*e.kids[0]);
             if (e.kids[1]) expr(*e.kids[1]);
+            if (!e.orbit_var.empty()) {
+                expr(*e.kids[3]);
+                auto m = globals_.find(e.orbit_map);
+                if (m == globals_.end() || m->second->kind != ItemKind::fn)
+                    d_.error(e.orbit_loc,
+                             fmt::format("the map of an orbit must be a function of a point, '{}' is not one",
+                                         e.orbit_map));
+                else if (m->second->params.size() != 1)
+                    d_.error(e.orbit_loc,
+                             fmt::format("the map of an orbit takes one point; '{}' takes {} arguments",
+                                         e.orbit_map, m->second->params.size()));
+            }
             scopes_.emplace_back();
             scopes_.back()[e.var] = 0;
+            if (!e.orbit_var.empty()) scopes_.back()[e.orbit_var] = 0;
             expr(*e.kids[2]);
             scopes_.pop_back();
             return;

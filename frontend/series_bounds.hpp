@@ -15,10 +15,15 @@ struct TermBound {
     ir::NodeId a = ir::no_node;
     ir::NodeId b = ir::no_node; // no_node: B = 0
     ir::Interval gamma{1.0, 1.0};
+    // Why the terms have no lower (upper) bound, when they have none: a min series needs only a
+    // lower bound, a max series only an upper bound, a sum both.
+    std::string no_lower, no_upper;
 };
 
-// Derives the bound of `term` as a function of the index of series `level`. On failure returns
-// nullopt and sets `why` to a sentence saying what cannot be bounded.
-std::optional<TermBound> bound_series_term(ir::Graph& g, ir::NodeId term, int level, std::string& why);
+// Derives the bound of `term` as a function of the index of series `level`, for a series of `kind`
+// (SeriesSum/Min/Max). On failure returns nullopt and sets `why` to a sentence saying what cannot be
+// bounded.
+std::optional<TermBound> bound_series_term(ir::Graph& g, ir::NodeId term, int level, ir::Op kind,
+                                           std::string& why);
 
 } // namespace frac::front

@@ -53,6 +53,7 @@ std::size_t Graph::KeyHash::operator()(const Node& n) const {
     mix(h, static_cast<std::uint64_t>(n.series.level));
     mix(h, static_cast<std::uint64_t>(n.series.start));
     mix(h, static_cast<std::uint64_t>(n.series.end));
+    for (NodeId o : n.orbit) mix(h, o);
     return h;
 }
 
@@ -62,7 +63,8 @@ bool Graph::KeyEq::operator()(const Node& a, const Node& b) const {
            bits(a.value.hi) == bits(b.value.hi) && bits(a.point) == bits(b.point) && a.imm == b.imm &&
            a.series.level == b.series.level && a.series.start == b.series.start &&
            a.series.end == b.series.end && bits(a.series.gamma.lo) == bits(b.series.gamma.lo) &&
-           bits(a.series.gamma.hi) == bits(b.series.gamma.hi);
+           bits(a.series.gamma.hi) == bits(b.series.gamma.hi) &&
+           a.series.state_count == b.series.state_count && a.orbit == b.orbit;
 }
 
 NodeId Graph::intern(const Node& n) {
@@ -72,7 +74,9 @@ NodeId Graph::intern(const Node& n) {
     stored.index_mask = 0;
     for (NodeId a : n.args)
         if (a != no_node) stored.index_mask |= nodes_[a].index_mask;
+    for (NodeId a : n.orbit) stored.index_mask |= nodes_[a].index_mask;
     if (n.op == Op::Index) stored.index_mask = std::uint64_t{1} << n.imm;
+    if (n.op == Op::State) stored.index_mask = std::uint64_t{1} << (n.imm / 8);
     if (is_series(n.op)) stored.index_mask &= ~(std::uint64_t{1} << n.series.level);
     const auto id = static_cast<NodeId>(nodes_.size());
     nodes_.push_back(stored);
@@ -100,6 +104,15 @@ NodeId Graph::index(int level) {
     Node n;
     n.op = Op::Index;
     n.imm = level;
+    return intern(n);
+}
+
+NodeId Graph::state(int level, int component) {
+    if (level < 1 || level > 63 || component < 0 || component > 7)
+        throw std::invalid_argument("orbit state out of range");
+    Node n;
+    n.op = Op::State;
+    n.imm = level * 8 + component;
     return intern(n);
 }
 
@@ -144,11 +157,15 @@ NodeId Graph::op(Op op, NodeId a, NodeId b, NodeId c, std::int64_t imm) {
     return intern(n);
 }
 
-NodeId Graph::series(Op kind, const SeriesData& data, NodeId body, NodeId tail_a, NodeId tail_b) {
+NodeId Graph::series(Op kind, const SeriesData& data, NodeId body, NodeId tail_a, NodeId tail_b,
+                     std::vector<NodeId> orbit) {
     if (!is_series(kind)) throw std::logic_error("Graph::series: not a series op");
+    if (orbit.size() != 2 * static_cast<std::size_t>(data.state_count))
+        throw std::logic_error("Graph::series: an orbit needs an initial point and a map");
     Node n;
     n.op = kind;
     n.series = data;
+    n.orbit = std::move(orbit);
     n.args = {body, tail_a, tail_b};
     return intern(n);
 }

@@ -36,12 +36,14 @@ inline constexpr std::int64_t infinite_end = std::numeric_limits<std::int64_t>::
 
 // What an infinite series needs for its tail: every term t_i (i >= start) lies in (A + B i) gamma^i,
 // with A and B enclosed by evaluating the nodes tail_a / tail_b over the current box (B may be absent)
-// and 0 < gamma < 1. The frontend proves this form (frontend/series_bounds).
+// and 0 < gamma < 1. A may be unbounded on one side: a min series needs only a lower bound of its
+// terms, a max series only an upper bound. The frontend proves this form (frontend/series_bounds).
 struct SeriesData {
     int level = 0; // nesting level; the body reads the index with Index(level)
     std::int64_t start = 0;
     std::int64_t end = infinite_end; // inclusive; infinite_end for an infinite series
     Interval gamma{0.0, 0.0};        // decay, proven 0 < gamma.hi < 1 for infinite series
+    int state_count = 0;             // orbit series: components of the orbit point
     bool operator==(const SeriesData&) const = default;
 };
 
@@ -52,6 +54,8 @@ struct Node {
     double point = 0.0;       // Const: its round-to-nearest value
     std::int64_t imm = 0;     // Var: input index; Index: level; PowI: exponent
     SeriesData series;        // series ops only
+    // Orbit series: the initial point's components, then the map's components (of State nodes).
+    std::vector<NodeId> orbit;
     // Bit L set when the node depends on the index of series level L (L >= 1); bit 0 unused.
     std::uint64_t index_mask = 0;
 };
@@ -65,9 +69,12 @@ public:
     NodeId constant(double exact) { return constant(Interval{exact, exact}, exact); }
     NodeId var(int index);
     NodeId index(int level);
+    // Component `component` of the orbit point of the series of level `level`.
+    NodeId state(int level, int component);
     // An operation; folds constants and a few identities, and returns an existing node when it has one.
     NodeId op(Op op, NodeId a, NodeId b = no_node, NodeId c = no_node, std::int64_t imm = 0);
-    NodeId series(Op kind, const SeriesData& data, NodeId body, NodeId tail_a, NodeId tail_b);
+    NodeId series(Op kind, const SeriesData& data, NodeId body, NodeId tail_a, NodeId tail_b,
+                  std::vector<NodeId> orbit = {});
 
     bool is_const(NodeId id) const { return nodes_[id].op == Op::Const; }
     // True when the node is a thin integer constant; sets `value`.

@@ -16,6 +16,7 @@ std::string print_graph(const Graph& g, const std::vector<NodeId>& roots) {
         live[id] = true;
         for (NodeId a : g[id].args)
             if (a != no_node) stack.push_back(a);
+        for (NodeId a : g[id].orbit) stack.push_back(a);
     }
     std::string out;
     for (NodeId id = 0; id < g.size(); ++id) {
@@ -27,6 +28,8 @@ std::string print_graph(const Graph& g, const std::vector<NodeId>& roots) {
             if (n.op == Op::Const)
                 out += n.value.is_thin() ? fmt::format(" {}", n.value.lo)
                                          : fmt::format(" [{}, {}] ~{}", n.value.lo, n.value.hi, n.point);
+            else if (n.op == Op::State)
+                out += fmt::format(" {}.{}", n.imm / 8, n.imm % 8);
             else
                 out += fmt::format(" {}", n.imm);
             break;
@@ -43,6 +46,15 @@ std::string print_graph(const Graph& g, const std::vector<NodeId>& roots) {
             if (s.end == infinite_end) {
                 const std::string b = n.args[2] == no_node ? "0" : fmt::format("%{}", n.args[2]);
                 out += fmt::format(" tail (%{} + {} i) * [{}, {}]^i", n.args[1], b, s.gamma.lo, s.gamma.hi);
+            }
+            if (s.state_count > 0) {
+                std::string from, map;
+                for (int c = 0; c < s.state_count; ++c) {
+                    from += fmt::format("{}%{}", c ? ", " : "", n.orbit[static_cast<std::size_t>(c)]);
+                    map += fmt::format("{}%{}", c ? ", " : "",
+                                       n.orbit[static_cast<std::size_t>(s.state_count + c)]);
+                }
+                out += fmt::format(" orbit from ({}) map ({})", from, map);
             }
             break;
         }

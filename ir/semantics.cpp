@@ -76,6 +76,7 @@ Interval apply_interval(Op op, const Interval* a, std::int64_t imm) {
     case Op::Const:
     case Op::Var:
     case Op::Index:
+    case Op::State:
     case Op::SeriesSum:
     case Op::SeriesMin:
     case Op::SeriesMax: break;
@@ -120,6 +121,7 @@ double apply_point(Op op, const double* a, std::int64_t imm) {
     case Op::Const:
     case Op::Var:
     case Op::Index:
+    case Op::State:
     case Op::SeriesSum:
     case Op::SeriesMin:
     case Op::SeriesMax: break;

@@ -12,6 +12,14 @@ Interval series_term_bound(Interval a, Interval b, bool has_b, Interval gamma_i,
     return mul(coeff, gamma_i);
 }
 
+namespace {
+
+bool tends_to_zero(Interval a, Interval b) {
+    return std::isfinite(a.lo) && std::isfinite(a.hi) && std::isfinite(b.lo) && std::isfinite(b.hi);
+}
+
+} // namespace
+
 Interval series_tail(Op kind, Interval a, Interval b, bool has_b, Interval gamma, std::int64_t n) {
     const Interval g1 = powi(gamma, n + 1); // gamma^(n+1)
     const Interval one_minus = sub(Interval(1.0), gamma);
@@ -33,7 +41,8 @@ Interval series_tail(Op kind, Interval a, Interval b, bool has_b, Interval gamma
                 add(mul(Interval(std::fmax(0.0, -a.lo)), s0), mul(Interval(std::fmax(0.0, -b.lo)), s1));
             lo = std::fmin(0.0, -neg_part.hi);
         }
-        return {lo, std::fmin(0.0, first.hi)};
+        // The infimum of terms tending to 0 is <= 0; they tend to 0 when A and B are bounded.
+        return {lo, tends_to_zero(a, b) ? std::fmin(0.0, first.hi) : first.hi};
     }
     case Op::SeriesMax: {
         const Interval first = series_term_bound(a, b, has_b, g1, n + 1);
@@ -45,7 +54,7 @@ Interval series_tail(Op kind, Interval a, Interval b, bool has_b, Interval gamma
                 add(mul(Interval(std::fmax(0.0, a.hi)), s0), mul(Interval(std::fmax(0.0, b.hi)), s1));
             hi = std::fmax(0.0, pos_part.hi);
         }
-        return {std::fmax(0.0, first.lo), hi};
+        return {tends_to_zero(a, b) ? std::fmax(0.0, first.lo) : first.lo, hi};
     }
     default: break;
     }

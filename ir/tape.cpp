@@ -90,9 +90,17 @@ private:
         t_.blocks.emplace_back();
         s.index_slot = fresh();
         contexts_.push_back({n.series.level, s.block, {}});
-        contexts_.back().memo[find_index_node(n.series.level)] = s.index_slot;
+        contexts_.back().memo[find_leaf(Op::Index, n.series.level)] = s.index_slot;
+        const auto states = static_cast<std::size_t>(n.series.state_count);
+        for (std::size_t c = 0; c < states; ++c) {
+            s.state_slots.push_back(fresh());
+            contexts_.back().memo[find_leaf(Op::State, n.series.level * 8 + static_cast<std::int64_t>(c))] =
+                s.state_slots.back();
+        }
         s.body_slot = emit(n.args[0]);
+        for (std::size_t c = 0; c < states; ++c) s.update_slots.push_back(emit(n.orbit[states + c]));
         contexts_.pop_back();
+        for (std::size_t c = 0; c < states; ++c) s.init_slots.push_back(emit(n.orbit[c]));
         if (n.args[1] != no_node) s.tail_a = emit(n.args[1]);
         if (n.args[2] != no_node) s.tail_b = emit(n.args[2]);
         Instr ins;
@@ -104,10 +112,10 @@ private:
         return ins.out;
     }
 
-    NodeId find_index_node(int level) {
-        // Index nodes are few; a linear scan once per series keeps Graph free of a reverse map.
+    NodeId find_leaf(Op op, std::int64_t imm) {
+        // Index and state nodes are few; a linear scan once per series keeps Graph free of a reverse map.
         for (NodeId i = 0; i < g_.size(); ++i)
-            if (g_[i].op == Op::Index && g_[i].imm == level) return i;
+            if (g_[i].op == op && g_[i].imm == imm) return i;
         return no_node;
     }
 
@@ -153,6 +161,9 @@ void print_block(const Tape& t, std::uint32_t b, int indent, std::string& out) {
                                slot_name(s.index_slot), s.data.start, end);
             print_block(t, s.block, indent + 2, out);
             out += fmt::format("{}}} term {}", pad, slot_name(s.body_slot));
+            for (std::size_t c = 0; c < s.state_slots.size(); ++c)
+                out += fmt::format("{} {} = {} then {}", c ? "," : " orbit", slot_name(s.state_slots[c]),
+                                   slot_name(s.init_slots[c]), slot_name(s.update_slots[c]));
             if (s.data.end == infinite_end)
                 out += fmt::format(" tail ({} + {} i) * {}^i", slot_name(s.tail_a), slot_name(s.tail_b),
                                    interval_text(s.data.gamma));
@@ -200,7 +211,17 @@ std::string verify_block(const Tape& t, std::uint32_t b, std::vector<bool>& writ
                 return fmt::format("series block {} out of order", s.block);
             if (s.index_slot >= t.num_slots) return "series index slot out of range";
             written[s.index_slot] = true;
+            if (s.init_slots.size() != s.state_slots.size() || s.update_slots.size() != s.state_slots.size())
+                return "orbit slots of different sizes";
+            for (Slot i : s.init_slots)
+                if (i >= t.num_slots || !written[i]) return "orbit initial point not written";
+            for (Slot st : s.state_slots) {
+                if (st >= t.num_slots || written[st]) return "orbit state slot written twice";
+                written[st] = true;
+            }
             if (auto e = verify_block(t, s.block, written); !e.empty()) return e;
+            for (Slot u : s.update_slots)
+                if (u >= t.num_slots || !written[u]) return "orbit map not written";
             if (s.body_slot >= t.num_slots || !written[s.body_slot]) return "series term slot not written";
             if (s.data.end == infinite_end) {
                 if (s.tail_a == no_slot || !written[s.tail_a])

@@ -28,6 +28,9 @@ struct TapeSeries {
     Slot index_slot = no_slot;
     Slot body_slot = no_slot;
     Slot tail_a = no_slot, tail_b = no_slot; // infinite series: tail coefficients (tail_b optional)
+    // Orbit series: the point's slots, read by the block; their initial values (computed before the
+    // series) and the map's values (computed by the block), copied into state_slots after each term.
+    std::vector<Slot> state_slots, init_slots, update_slots;
 };
 
 struct TapeConst {

@@ -18,6 +18,12 @@ std::string verify_graph(const Graph& g) {
             if (a != no_node && a >= id) return fmt::format("%{}: argument %{} is not earlier", id, a);
         }
         if (n.op == Op::Index && (n.imm < 1 || n.imm > 63)) return fmt::format("%{}: bad index level", id);
+        if (n.op == Op::State && (n.imm / 8 < 1 || n.imm / 8 > 63))
+            return fmt::format("%{}: bad orbit state", id);
+        if (n.orbit.size() != 2 * static_cast<std::size_t>(n.series.state_count))
+            return fmt::format("%{}: orbit of the wrong size", id);
+        for (NodeId a : n.orbit)
+            if (a >= id) return fmt::format("%{}: orbit argument %{} is not earlier", id, a);
         if (is_series(n.op)) {
             const SeriesData& s = n.series;
             if (s.level < 1) return fmt::format("%{}: series without level", id);

@@ -92,6 +92,15 @@ private:
         }
     }
 
+    static bool one_sided(Op kind, Interval tail) {
+        return (kind == Op::SeriesMin && std::isinf(tail.hi)) ||
+               (kind == Op::SeriesMax && std::isinf(tail.lo));
+    }
+    static bool tail_cannot_improve(Op kind, Interval acc, Interval term, Interval tail) {
+        if (kind == Op::SeriesMin) return tail.lo >= acc.lo && term.hi >= acc.hi;
+        return tail.hi <= acc.hi && term.lo <= acc.lo;
+    }
+
     std::int64_t last_index(const TapeSeries& s) const {
         return s.data.end == ir::infinite_end ? s.data.start + options_.max_terms - 1 : s.data.end;
     }
@@ -107,10 +116,14 @@ private:
         Interval acc;
         std::int64_t i = s.data.start;
         bool resolved = !infinite;
+        for (std::size_t c = 0; c < s.state_slots.size(); ++c)
+            boxes_[s.state_slots[c]] = boxes_[s.init_slots[c]];
         for (;; ++i) {
             boxes_[s.index_slot] = Interval(static_cast<double>(i));
             run_boxes(s.block);
             const Interval term = boxes_[s.body_slot];
+            for (std::size_t c = 0; c < s.state_slots.size(); ++c)
+                boxes_[s.state_slots[c]] = boxes_[s.update_slots[c]];
             acc = i == s.data.start ? term : ir::series_combine(s.kind, acc, term);
             ++stats.series_terms;
             if (i == last) break;
@@ -124,6 +137,12 @@ private:
                 }
                 const Interval tail = ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i);
                 if (num::width(tail) <= 0x1p-52 * num::magnitude(acc) || num::width(tail) == 0) {
+                    resolved = true;
+                    break;
+                }
+                // A one-sided tail (terms bounded on one side only): stop once the tail cannot move
+                // the bound it knows and this term did not improve the other one.
+                if (one_sided(s.kind, tail) && tail_cannot_improve(s.kind, acc, term, tail)) {
                     resolved = true;
                     break;
                 }
@@ -146,10 +165,14 @@ private:
         double acc = 0.0;
         std::int64_t i = s.data.start;
         bool resolved = !infinite;
+        for (std::size_t c = 0; c < s.state_slots.size(); ++c)
+            points_[s.state_slots[c]] = points_[s.init_slots[c]];
         for (;; ++i) {
             points_[s.index_slot] = static_cast<double>(i);
             run_points(s.block);
             const double term = points_[s.body_slot];
+            for (std::size_t c = 0; c < s.state_slots.size(); ++c)
+                points_[s.state_slots[c]] = points_[s.update_slots[c]];
             acc = i == s.data.start ? term : ir::series_combine_point(s.kind, acc, term);
             ++stats.series_terms;
             if (i == last) break;
@@ -173,6 +196,8 @@ private:
                 ir::series_tail(s.kind, Interval(points_[s.tail_a]),
                                 has_b ? Interval(points_[s.tail_b]) : Interval(0.0), has_b, s.data.gamma, i);
         }
+        // A tail unbounded on one side tells nothing about the value: keep the partial result.
+        if (!std::isfinite(tail.lo) || !std::isfinite(tail.hi)) return acc;
         return ir::series_combine_point(s.kind, acc, num::midpoint(tail));
     }
 
