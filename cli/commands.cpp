@@ -69,9 +69,10 @@ rt::RssProgress terminal_progress() {
     };
 }
 
-rt::RssResult cover(const front::ShapeInfo& s, const std::vector<ir::Interval>& box, int depth, int split,
-                    bool keep_cells, ir::Evaluator& eval) {
+rt::RssResult cover(const std::vector<ir::Interval>& box, int depth, int split, bool keep_cells, int threads,
+                    ir::Evaluator& eval) {
     rt::RssOptions ro;
+    ro.threads = threads;
     ro.depth = depth;
     ro.split = split;
     ro.keep_cells = keep_cells;
@@ -109,7 +110,7 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
         throw RunError(fmt::format("shape '{}' is {}D; pictures are of 2D shapes", s.name, s.dimension));
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
-    const rt::RssResult r = cover(s, box, o.depth, o.split, true, *eval);
+    const rt::RssResult r = cover(box, o.depth, o.split, true, engine.threads, *eval);
     std::cerr << fmt::format(
         "{}: depth {}, {} boxes evaluated: {} inside, {} outside, {} boundary; {:.3f} s\n", s.name, o.depth,
         r.evaluated, r.inside, r.outside, r.boundary, r.seconds);
@@ -141,7 +142,7 @@ int run_dimension(const std::string& file, const std::string& shape, int from, i
     if (!c) return front::exit_compile_error;
     const front::ShapeInfo& s = pick_shape(*c, shape);
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
-    const rt::RssResult r = cover(s, s.box, to, split, false, *eval);
+    const rt::RssResult r = cover(s.box, to, split, false, engine.threads, *eval);
     rt::DimensionEstimate d;
     try {
         d = rt::box_counting(r, from, to);

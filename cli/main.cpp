@@ -15,6 +15,8 @@ int main(int argc, char** argv) {
         sub->add_option("--max-terms", engine.eval.max_terms,
                         "most terms of an infinite series before its tail bound")
             ->check(CLI::Range(1, ir::max_terms_limit));
+        sub->add_option("--threads", engine.threads, "subdivision threads (0: all cores)")
+            ->check(CLI::Range(0, 1024));
     };
 
     std::string file, shape, emit, at, box;

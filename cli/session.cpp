@@ -123,6 +123,7 @@ std::vector<ir::Interval> answer_queries(const front::Module& m, const ir::Tape&
                 ro.depth = q.to;
                 ro.split = q.split;
                 ro.keep_cells = false;
+                ro.threads = options.threads;
                 try {
                     const rt::RssResult r = rt::subdivide(*eval, q.box, ro);
                     answers[k] = ir::Interval(rt::box_counting(r, q.from, q.to).dimension);

@@ -15,6 +15,7 @@ namespace frac::cli {
 struct EngineOptions {
     std::string engine = "interp";
     ir::EvalOptions eval;
+    int threads = 0; // subdivision threads; 0: all cores
 };
 
 // A user-facing run-time failure (bad option value, unknown shape, I/O): message and exit code 1.

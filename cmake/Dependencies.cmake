@@ -4,6 +4,7 @@ find_package(Catch2 2 REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(PNG REQUIRED)
 find_package(PkgConfig REQUIRED)
+find_package(TBB REQUIRED) # parallel subdivision
 
 # LLVM's libc: correctly rounded exp/log/sin/cos/tan that honour the current rounding mode.
 find_library(LLVMLIBC_ARCHIVE llvmlibc PATHS /usr/lib/llvm-19/lib NO_DEFAULT_PATH REQUIRED)

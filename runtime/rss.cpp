@@ -1,5 +1,9 @@
 #include "runtime/rss.hpp"
 
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+#include <thread>
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -85,16 +89,35 @@ void validate(const ir::Evaluator& f, const std::vector<Interval>& root, const R
             "subdivide: split^depth = {}^{} exceeds 2^32 cells per axis (cell positions are 32-bit)", o.split,
             o.depth));
     if (o.batch == 0) throw std::invalid_argument("subdivide: batch must be at least 1");
+    if (o.threads < 0 || o.threads > 1024)
+        throw std::invalid_argument("subdivide: threads must be in [0, 1024]");
 }
 
 // One run of the subdivision. Holds the frontier of the current level (its undecided cells) and
 // the batch being filled, nothing else unless keep_cells.
 class Runner {
 public:
-    Runner(ir::Evaluator& f, RssResult& r) : f_(f), r_(r), d_(r.dimension()) {
+    Runner(ir::Evaluator& f, RssResult& r)
+        : f_(f), r_(r), d_(r.dimension()),
+          threads_(r.options.threads > 0
+                       ? r.options.threads
+                       : std::max(1, static_cast<int>(std::thread::hardware_concurrency()))),
+          arena_(threads_) {
         num::UpwardRounding up;
         for (const Interval& x : r_.root) width_.push_back(axis_width(x));
-        queue_.reserve(std::min<std::size_t>(r_.options.batch, 1 << 16));
+        for (int t = 1; t < threads_; ++t) clones_.push_back(f_.clone());
+        // Each thread gets a batch of its own per flush.
+        flush_at_ = r_.options.batch * static_cast<std::size_t>(threads_);
+        queue_.reserve(std::min<std::size_t>(flush_at_, 1 << 16));
+    }
+
+    ~Runner() {
+        // The clones' work counts as the caller's evaluator's.
+        for (const auto& c : clones_) {
+            f_.stats.calls += c->stats.calls;
+            f_.stats.series_terms += c->stats.series_terms;
+            f_.stats.series_capped += c->stats.series_capped;
+        }
     }
 
     void run() {
@@ -159,7 +182,7 @@ private:
 
     void push(Pos p) {
         queue_.push_back(p);
-        if (queue_.size() >= r_.options.batch) flush();
+        if (queue_.size() >= flush_at_) flush();
     }
 
     // Evaluates the queued cells of the current level in one eval_boxes call and classifies them.
@@ -177,7 +200,7 @@ private:
                     boxes_[j * d + a] = cell_axis(r_.root[a], width_[a], pos[a], n_);
             }
         }
-        f_.eval_boxes(boxes_.data(), m, out_.data());
+        evaluate(m);
 
         const bool last = level_ == r_.options.depth;
         LevelCounts& lc = r_.levels[static_cast<std::size_t>(level_)];
@@ -214,9 +237,32 @@ private:
         }
     }
 
+    // Evaluates boxes_[0, m) into out_: in one call, or in one contiguous chunk per thread.
+    void evaluate(std::size_t m) {
+        const auto d = static_cast<std::size_t>(d_);
+        const auto chunks =
+            std::min<std::size_t>(static_cast<std::size_t>(threads_), (m + min_chunk - 1) / min_chunk);
+        if (chunks <= 1) {
+            f_.eval_boxes(boxes_.data(), m, out_.data());
+            return;
+        }
+        arena_.execute([&] {
+            tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+                const std::size_t begin = m * c / chunks, end = m * (c + 1) / chunks;
+                ir::Evaluator& e = c == 0 ? f_ : *clones_[c - 1];
+                e.eval_boxes(boxes_.data() + begin * d, end - begin, out_.data() + begin);
+            });
+        });
+    }
+
+    static constexpr std::size_t min_chunk = 256; // below this a thread costs more than it saves
     ir::Evaluator& f_;
     RssResult& r_;
     int d_;
+    int threads_;
+    tbb::task_arena arena_;
+    std::vector<std::unique_ptr<ir::Evaluator>> clones_;
+    std::size_t flush_at_ = 0;
     int level_ = 0;
     std::uint64_t n_ = 1;               // cells per axis at level_
     std::vector<Interval> width_;       // enclosure of the root's width per axis

@@ -47,6 +47,9 @@ struct RssOptions {
     bool keep_cells = true;   // record every evaluated cell (for pictures); false keeps only counts
     std::size_t batch = 4096; // cells per eval_boxes call (>= 1)
     RssProgress progress;     // optional
+    // Threads evaluating each batch (0: all cores). Each thread has its own clone of the evaluator,
+    // and results are placed by cell position, so the output is the same for every thread count.
+    int threads = 1;
 };
 
 // Hard limits, reported as errors when exceeded. Besides, split^depth must not exceed 2^32 (cell
