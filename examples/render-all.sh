@@ -14,6 +14,16 @@ render fig3_staircase.frac staircase_graph 10
 render fig5_cantor.frac cantor_graph 10
 render fig6_carpet.frac sierpinski_carpet 9
 render fig7_triangle.frac sierpinski_triangle 9
+render_as() { # file shape depth name
+    "$frac" render "$here/$1" "$2" --depth "$3" --size 512 -o "$out/$4.png"
+}
+render_as fig9_koch_tiling.frac triangle_tiling 8 fig9_tiling
+render_as fig9_koch_tiling.frac lattice_disks 8 fig9_disks
+render fig10_double_koch.frac double_flake 8
+render_as fig11_koch_levels.frac flake0 8 fig11_flake0
+render_as fig11_koch_levels.frac flake1 8 fig11_flake1
+render_as fig11_koch_levels.frac flake2 8 fig11_flake2
+render fig13_koch_polar.frac koch_flake 7
 echo
 echo "pictures (left: recursive subdivision process, right: cover) are in $out:"
 ls -1 "$out" | sed "s|^|  $out/|"

@@ -148,6 +148,11 @@ NodeId Graph::op(Op op, NodeId a, NodeId b, NodeId c, std::int64_t imm) {
         if (wanted) all_const = all_const && is_const(args[i]);
     }
     if (all_const) return fold(n);
+    // A value compared with itself (the same node: the same real number) needs no interval.
+    if (a == b && op_class(op) == OpClass::logic && arity(op) == 2 && op != Op::And && op != Op::Or) {
+        const bool holds = op == Op::Le || op == Op::Ge || op == Op::Eq;
+        return constant(holds ? tv_true : tv_false, holds ? 1.0 : 0.0);
+    }
     // A select on a decided condition is its branch.
     if (op == Op::Select && is_const(a)) {
         const Interval cond = nodes_[a].value;
