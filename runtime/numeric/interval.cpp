@@ -31,7 +31,9 @@ inline double opaque(double x) {
 }
 
 // Keeps memory accesses and calls from moving across a rounding-mode change.
-inline void barrier() { asm volatile("" ::: "memory"); }
+inline void barrier() {
+    asm volatile("" ::: "memory");
+}
 
 // Neighbouring doubles, exact in any rounding mode (glibc's nextafter is much slower).
 double next_up(double x) {
@@ -40,20 +42,36 @@ double next_up(double x) {
     const auto bits = std::bit_cast<std::uint64_t>(x);
     return std::bit_cast<double>(x > 0 ? bits + 1 : bits - 1);
 }
-double next_down(double x) { return -next_up(-x); }
+double next_down(double x) {
+    return -next_up(-x);
+}
 
 // Bounds that came out NaN (inf - inf on degenerate [inf, inf] operands) widen to infinity.
-Interval widen_nan(double lo, double hi) { return {std::isnan(lo) ? -inf : lo, std::isnan(hi) ? inf : hi}; }
+Interval widen_nan(double lo, double hi) {
+    return {std::isnan(lo) ? -inf : lo, std::isnan(hi) ? inf : hi};
+}
 
 // Rounded-down operations via RD(f) = -RU(-f); valid only under upward rounding.
-double add_down(double x, double y) { return -opaque(opaque(-x) - y); }
-double sub_down(double x, double y) { return -opaque(opaque(-x) + y); }
-double mul_down(double x, double y) { return -opaque(opaque(-x) * y); }
-double div_down(double x, double y) { return -opaque(opaque(-x) / y); }
+double add_down(double x, double y) {
+    return -opaque(opaque(-x) - y);
+}
+double sub_down(double x, double y) {
+    return -opaque(opaque(-x) + y);
+}
+double mul_down(double x, double y) {
+    return -opaque(opaque(-x) * y);
+}
+double div_down(double x, double y) {
+    return -opaque(opaque(-x) / y);
+}
 
 // Products in which a zero factor beats an infinite one (0 * inf = 0, IEEE 1788).
-double mul_up0(double x, double y) { return x == 0 || y == 0 ? 0.0 : x * y; }
-double mul_down0(double x, double y) { return x == 0 || y == 0 ? 0.0 : mul_down(x, y); }
+double mul_up0(double x, double y) {
+    return x == 0 || y == 0 ? 0.0 : x * y;
+}
+double mul_down0(double x, double y) {
+    return x == 0 || y == 0 ? 0.0 : mul_down(x, y);
+}
 
 constexpr double pi_lo = 0x1.921fb54442d18p+1; // RN(pi) < pi
 constexpr double pi_hi = 0x1.921fb54442d19p+1;
@@ -76,11 +94,21 @@ bool hits_mod4(Interval t, int r) {
 // The libc functions return RU(f(x)). For lower bounds the odd ones use RD(f(x)) = -RU(f(-x)); the
 // others step one double down, which is < f(x) unless f(x) is a double: by Lindemann's theorem only
 // at the exact points special-cased here.
-double sin_down(double x) { return -crlibm::sin(-x); }
-double cos_down(double x) { return x == 0 ? 1.0 : std::max(-1.0, next_down(crlibm::cos(x))); }
-double tan_down(double x) { return -crlibm::tan(-x); }
-double exp_down(double x) { return x == 0 ? 1.0 : std::max(0.0, next_down(crlibm::exp(x))); }
-double log_down(double x) { return x == 1 ? 0.0 : next_down(crlibm::log(x)); }
+double sin_down(double x) {
+    return -crlibm::sin(-x);
+}
+double cos_down(double x) {
+    return x == 0 ? 1.0 : std::max(-1.0, next_down(crlibm::cos(x)));
+}
+double tan_down(double x) {
+    return -crlibm::tan(-x);
+}
+double exp_down(double x) {
+    return x == 0 ? 1.0 : std::max(0.0, next_down(crlibm::exp(x)));
+}
+double log_down(double x) {
+    return x == 1 ? 0.0 : next_down(crlibm::log(x));
+}
 
 // x^n for x >= 0 by repeated squaring; each step is monotone in its operands, so rounding every
 // product in one direction bounds the exact power in that direction.
@@ -106,13 +134,18 @@ Interval pow_positive(Interval a, std::uint64_t n) {
         return {pow_down(m.lo, n), pow_up(m.hi, n)};
     }
     // Odd powers are increasing and odd: x^n = -((-x)^n).
-    return {a.lo >= 0 ? pow_down(a.lo, n) : -pow_up(-a.lo, n), a.hi >= 0 ? pow_up(a.hi, n) : -pow_down(-a.hi, n)};
+    return {a.lo >= 0 ? pow_down(a.lo, n) : -pow_up(-a.lo, n),
+            a.hi >= 0 ? pow_up(a.hi, n) : -pow_down(-a.hi, n)};
 }
 
 // Distance of a double to the nearest integer, rounded down / up (x - floor(x) can be inexact for
 // negative x of small magnitude).
-double dz_down(double x) { return std::min(sub_down(x, std::floor(x)), sub_down(std::ceil(x), x)); }
-double dz_up(double x) { return std::min(x - std::floor(x), std::ceil(x) - x); }
+double dz_down(double x) {
+    return std::min(sub_down(x, std::floor(x)), sub_down(std::ceil(x), x));
+}
+double dz_up(double x) {
+    return std::min(x - std::floor(x), std::ceil(x) - x);
+}
 
 } // namespace
 
@@ -126,7 +159,9 @@ UpwardRounding::~UpwardRounding() {
     std::fesetround(saved_);
 }
 
-bool rounding_is_upward() { return std::fegetround() == FE_UPWARD; }
+bool rounding_is_upward() {
+    return std::fegetround() == FE_UPWARD;
+}
 
 double width(Interval a) {
     if (a.is_empty()) return 0.0;
@@ -145,7 +180,9 @@ double midpoint(Interval a) {
     return std::clamp(0.5 * a.lo + 0.5 * a.hi, a.lo, a.hi);
 }
 
-double magnitude(Interval a) { return a.is_empty() ? 0.0 : std::max(std::abs(a.lo), std::abs(a.hi)); }
+double magnitude(Interval a) {
+    return a.is_empty() ? 0.0 : std::max(std::abs(a.lo), std::abs(a.hi));
+}
 
 Interval hull(Interval a, Interval b) {
     if (a.is_empty()) return b;
@@ -171,7 +208,8 @@ Interval sub(Interval a, Interval b) {
 Interval mul(Interval a, Interval b) {
     if (a.is_empty() || b.is_empty()) return Interval::empty();
     // The product is bilinear, so its extremes are at the corners.
-    return {std::min({mul_down0(a.lo, b.lo), mul_down0(a.lo, b.hi), mul_down0(a.hi, b.lo), mul_down0(a.hi, b.hi)}),
+    return {std::min(
+                {mul_down0(a.lo, b.lo), mul_down0(a.lo, b.hi), mul_down0(a.hi, b.lo), mul_down0(a.hi, b.hi)}),
             std::max({mul_up0(a.lo, b.lo), mul_up0(a.lo, b.hi), mul_up0(a.hi, b.lo), mul_up0(a.hi, b.hi)})};
 }
 
@@ -195,9 +233,13 @@ Interval div(Interval a, Interval b) {
     return Interval::entire();
 }
 
-Interval neg(Interval a) { return {-a.hi, -a.lo}; }
+Interval neg(Interval a) {
+    return {-a.hi, -a.lo};
+}
 
-Interval sqr(Interval a) { return a.is_empty() ? a : pow_positive(a, 2); }
+Interval sqr(Interval a) {
+    return a.is_empty() ? a : pow_positive(a, 2);
+}
 
 Interval powi(Interval a, std::int64_t n) {
     if (a.is_empty()) return a;
@@ -245,9 +287,13 @@ Interval max(Interval a, Interval b) {
     return {std::max(a.lo, b.lo), std::max(a.hi, b.hi)};
 }
 
-Interval floor(Interval a) { return a.is_empty() ? a : Interval{std::floor(a.lo), std::floor(a.hi)}; }
+Interval floor(Interval a) {
+    return a.is_empty() ? a : Interval{std::floor(a.lo), std::floor(a.hi)};
+}
 
-Interval ceil(Interval a) { return a.is_empty() ? a : Interval{std::ceil(a.lo), std::ceil(a.hi)}; }
+Interval ceil(Interval a) {
+    return a.is_empty() ? a : Interval{std::ceil(a.lo), std::ceil(a.hi)};
+}
 
 Interval mod1(Interval a) {
     if (a.is_empty()) return a;
@@ -333,9 +379,13 @@ Interval atan2(Interval y, Interval x) {
     return {std::max(lo, -pi_hi), std::min(hi, pi_hi)};
 }
 
-Interval pi() { return {pi_lo, pi_hi}; }
+Interval pi() {
+    return {pi_lo, pi_hi};
+}
 
-Interval e() { return {e_lo, e_hi}; }
+Interval e() {
+    return {e_lo, e_hi};
+}
 
 Interval from_decimal(const std::string& text) {
     // glibc's strtod rounds in the current mode, so two parses give the outward enclosure.
@@ -355,9 +405,13 @@ Interval from_decimal(const std::string& text) {
 
 namespace point {
 
-double dz(double x) { return std::min(x - std::floor(x), std::ceil(x) - x); }
+double dz(double x) {
+    return std::min(x - std::floor(x), std::ceil(x) - x);
+}
 
-double mod1(double x) { return x - std::floor(x); }
+double mod1(double x) {
+    return x - std::floor(x);
+}
 
 } // namespace point
 
