@@ -362,8 +362,17 @@ Interval log(Interval a) {
 
 Interval atan2(Interval y, Interval x) {
     if (y.is_empty() || x.is_empty()) return Interval::empty();
+    // A box in the closed upper half-plane (y >= 0) sees angles in [0, pi] only, continuously: on the
+    // cut the real angle atan2(0, x < 0) is pi, which is what atan2(+0, x) gives for the corners.
+    // (The closed lower half-plane has no such property: its points with y = 0, x < 0 have angle pi.)
+    const bool upper = y.lo == 0 && y.hi >= 0;
+    if (upper) {
+        y.lo = 0.0; // +0, also for -0
+        if (y.hi == 0) y.hi = 0.0;
+    }
+    if (upper && x.lo <= 0 && x.hi >= 0) return {0.0, pi_hi};
     // A box containing the origin, or meeting the branch cut (x < 0, y = 0), can see every angle.
-    if (x.lo <= 0 && y.lo <= 0 && y.hi >= 0) return {-pi_hi, pi_hi};
+    if (!upper && x.lo <= 0 && y.lo <= 0 && y.hi >= 0) return {-pi_hi, pi_hi};
     // Otherwise the box lies in an open half-plane of the cut plane, where the angle is continuous and
     // its extremes over a convex set are at vertices. glibc's atan2 is accurate to well under 1 ulp
     // (measured at <= 0.502 ulp in both nearest and upward mode; glibc documents at most 1 ulp), so

@@ -209,13 +209,21 @@ TEST_CASE("atan2 across quadrants, the branch cut and the origin", "[numeric][tr
     const Interval right = num::atan2({-1, 1}, {1, 2});
     CHECK((encloses(right, -pi_ld / 4) && encloses(right, pi_ld / 4) && right.hi < 0.79));
     CHECK(num::atan2({-1, 1}, {-2, -1}) == full);
-    CHECK(num::atan2({0, 1}, {-2, -1}) == full);
-    CHECK(num::atan2(0.0, -1.0) == full);
+    // A box touching the cut from above (y >= 0) sees only angles up to pi: atan2(0, x < 0) = pi.
+    const Interval touching = num::atan2({0, 1}, {-2, -1});
+    CHECK((encloses(touching, pi_ld) && encloses(touching, 3 * pi_ld / 4) && touching.lo > 2.3));
+    const Interval on_cut = num::atan2(0.0, -1.0);
+    CHECK((encloses(on_cut, pi_ld) && on_cut.lo > 3.14));
+    CHECK(num::atan2(-0.0, -1.0) == on_cut); // the real number 0 has no sign
+    // From below, y = 0 with x < 0 has angle pi while the rest is near -pi: every angle.
+    CHECK(num::atan2({-1, 0}, {-2, -1}) == full);
     CHECK(encloses(full, pi_ld));
     // Boxes containing the origin.
     CHECK(num::atan2({-1, 1}, {-1, 1}) == full);
-    CHECK(num::atan2(0.0, 0.0) == full);
-    CHECK(num::atan2(0.0, {0, 1}) == full);
+    CHECK(num::atan2({-1, 0}, {-1, 1}) == full);
+    const Interval upper_origin = num::atan2({0, 1}, {-1, 1});
+    CHECK((upper_origin.lo == 0 && encloses(upper_origin, pi_ld)));
+    CHECK(num::atan2(0.0, {0, 1}).lo == 0);
     const Interval unbounded = num::atan2({1, inf}, {1, inf});
     CHECK((unbounded.lo <= 1e-300 && encloses(unbounded, pi_ld / 2)));
     for (Interval a : {diag, q2, q3, q4, upper, right, unbounded}) CHECK(within_pi(a));
