@@ -2,6 +2,7 @@
 #include "cli/commands.hpp"
 
 #include "runtime/dimension.hpp"
+#include "runtime/mesh.hpp"
 #include "runtime/picture.hpp"
 #include "runtime/rss.hpp"
 
@@ -154,6 +155,40 @@ int run_dimension(const std::string& file, const std::string& shape, int from, i
     std::cout << fmt::format("box-counting dimension of {}: {:.4f} (r^2 = {:.5f}, levels {}..{}, split {})\n",
                              s.name, d.dimension, d.r_squared, from, to, split);
     return 0;
+}
+
+int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions& engine) {
+    if (o.output.empty()) throw RunError("give -o out.stl|out.obj|out.ply");
+    if (!ends_with(o.output, ".stl") && !ends_with(o.output, ".obj") && !ends_with(o.output, ".ply"))
+        throw RunError(fmt::format("cannot tell the mesh format of '{}': use .stl, .obj or .ply", o.output));
+    rt::MeshSelection selection = rt::MeshSelection::inside;
+    if (o.select == "cover")
+        selection = rt::MeshSelection::inside_and_boundary;
+    else if (o.select != "inside")
+        throw RunError(fmt::format("unknown selection '{}' (inside, cover)", o.select));
+    auto c = compile_or_report(file);
+    if (!c) return front::exit_compile_error;
+    const front::ShapeInfo& s = pick_shape(*c, o.shape);
+    if (s.dimension != 3)
+        throw RunError(fmt::format("shape '{}' is {}D; meshes are of 3D shapes", s.name, s.dimension));
+    auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
+    const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
+    const rt::RssResult r = cover(box, o.depth, o.split, true, engine.threads, *eval);
+    const rt::Mesh mesh = rt::mesh_cover(r, selection);
+    const rt::MeshCheck check = rt::check_mesh(mesh);
+    std::cerr << fmt::format("{}: depth {} split {}: {} cells ({} inside, {} boundary), {} triangles; {}, "
+                             "Euler characteristic {}, {} components\n",
+                             s.name, o.depth, o.split, mesh.stats.cells, r.inside, r.boundary,
+                             mesh.triangles.size(),
+                             check.ok() ? "watertight and manifold" : "NOT printable: " + check.problem,
+                             check.euler, check.components);
+    try {
+        rt::write_mesh(mesh, o.output);
+    } catch (const std::exception& e) {
+        throw RunError(e.what());
+    }
+    std::cerr << fmt::format("wrote {}\n", o.output);
+    return check.ok() ? 0 : 1;
 }
 
 } // namespace frac::cli

@@ -17,6 +17,11 @@ int run_check(const std::string& file, const std::string& emit, const std::strin
 int run_eval(const std::string& file, const std::string& shape, const std::string& at, const std::string& box,
              const EngineOptions& engine);
 int run_render(const std::string& file, const RenderOptions& options, const EngineOptions& engine);
+struct MeshOptions {
+    std::string shape, box, output, select = "inside";
+    int depth = 4, split = 2;
+};
+int run_mesh(const std::string& file, const MeshOptions& options, const EngineOptions& engine);
 int run_dimension(const std::string& file, const std::string& shape, int from, int to, int split,
                   const EngineOptions& engine);
 // Runs the print statements (when `prints`) and the tests of each file; prints "N passed, N failed".

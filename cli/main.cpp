@@ -11,7 +11,8 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     cli::EngineOptions engine;
     auto add_engine = [&](CLI::App* sub) {
-        sub->add_option("--engine", engine.engine, "evaluation engine")->check(CLI::IsMember({"interp"}));
+        sub->add_option("--engine", engine.engine, "evaluation engine: jit (default) or interp")
+            ->check(CLI::IsMember({"jit", "interp"}));
         sub->add_option("--max-terms", engine.eval.max_terms,
                         "most terms of an infinite series before its tail bound")
             ->check(CLI::Range(1, ir::max_terms_limit));
@@ -46,6 +47,19 @@ int main(int argc, char** argv) {
     render->add_option("--ascii", render_options.ascii, "also print a COLSxROWS character picture");
     add_engine(render);
 
+    cli::MeshOptions mesh_options;
+    auto* mesh =
+        app.add_subcommand("mesh", "cover a 3D shape by an octree and write a watertight mesh of it");
+    mesh->add_option("file", file, "model file")->required();
+    mesh->add_option("shape", mesh_options.shape, "shape name (default: the last shape of the file)");
+    mesh->add_option("--depth", mesh_options.depth, "subdivision depth")->check(CLI::Range(0, 64));
+    mesh->add_option("--split", mesh_options.split, "parts per axis and level")->check(CLI::Range(2, 4));
+    mesh->add_option("--box", mesh_options.box, "box x0:x1,y0:y1,z0:z1 (default: the shape's)");
+    mesh->add_option("--select", mesh_options.select,
+                     "inside: the proven-inside cells; cover: inside and boundary cells");
+    mesh->add_option("-o,--output", mesh_options.output, "mesh file: .stl (binary), .obj or .ply");
+    add_engine(mesh);
+
     int from = 4, to = 9, split = 2;
     auto* dimension =
         app.add_subcommand("dimension", "box-counting dimension of a shape's boundary from its cover");
@@ -75,6 +89,7 @@ int main(int argc, char** argv) {
         if (*eval) return cli::run_eval(file, shape, at, box, engine);
         if (*render) return cli::run_render(file, render_options, engine);
         if (*dimension) return cli::run_dimension(file, shape, from, to, split, engine);
+        if (*mesh) return cli::run_mesh(file, mesh_options, engine);
         if (*test) return cli::run_tests(files, false, engine);
         if (*run) return cli::run_tests({file}, true, engine);
     } catch (const cli::RunError& e) {

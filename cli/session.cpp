@@ -1,6 +1,7 @@
 #include "cli/session.hpp"
 
 #include "backend/interp/interpreter.hpp"
+#include "backend/llvm/jit.hpp"
 #include "runtime/dimension.hpp"
 #include "runtime/rss.hpp"
 
@@ -41,8 +42,22 @@ std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId
     ir::Tape tape = ir::build_tape(m.graph, root, inputs);
     if (std::string defect = ir::verify_tape(tape); !defect.empty())
         throw front::InternalError("malformed tape: " + defect);
-    if (options.engine != "interp")
-        throw RunError(fmt::format("unknown engine '{}' (available: interp)", options.engine));
+    if (options.engine == "jit") {
+        std::string why;
+        if (jit::jit_available(&why)) {
+            try {
+                return jit::make_jit(tape, options.eval);
+            } catch (const jit::JitError& e) {
+                why = e.what();
+            }
+        }
+        static bool told = false; // say it once per run
+        if (!told)
+            std::cerr << fmt::format("frac: note: the JIT cannot be used ({}); using the interpreter\n", why);
+        told = true;
+    } else if (options.engine != "interp") {
+        throw RunError(fmt::format("unknown engine '{}' (available: jit, interp)", options.engine));
+    }
     return interp::make_interpreter(std::move(tape), options.eval);
 }
 

@@ -92,6 +92,14 @@ private:
         }
     }
 
+    // p <- M(p) for all components at once: a map's component may be another state slot (a swap).
+    template <class V>
+    static void advance_orbit(std::vector<V>& regs, const TapeSeries& s) {
+        V next[8];
+        for (std::size_t c = 0; c < s.state_slots.size(); ++c) next[c] = regs[s.update_slots[c]];
+        for (std::size_t c = 0; c < s.state_slots.size(); ++c) regs[s.state_slots[c]] = next[c];
+    }
+
     static bool one_sided(Op kind, Interval tail) {
         return (kind == Op::SeriesMin && std::isinf(tail.hi)) ||
                (kind == Op::SeriesMax && std::isinf(tail.lo));
@@ -122,8 +130,7 @@ private:
             boxes_[s.index_slot] = Interval(static_cast<double>(i));
             run_boxes(s.block);
             const Interval term = boxes_[s.body_slot];
-            for (std::size_t c = 0; c < s.state_slots.size(); ++c)
-                boxes_[s.state_slots[c]] = boxes_[s.update_slots[c]];
+            advance_orbit(boxes_, s);
             acc = i == s.data.start ? term : ir::series_combine(s.kind, acc, term);
             ++stats.series_terms;
             if (i == last) break;
@@ -171,8 +178,7 @@ private:
             points_[s.index_slot] = static_cast<double>(i);
             run_points(s.block);
             const double term = points_[s.body_slot];
-            for (std::size_t c = 0; c < s.state_slots.size(); ++c)
-                points_[s.state_slots[c]] = points_[s.update_slots[c]];
+            advance_orbit(points_, s);
             acc = i == s.data.start ? term : ir::series_combine_point(s.kind, acc, term);
             ++stats.series_terms;
             if (i == last) break;

@@ -1,0 +1,42 @@
+// Tape -> LLVM IR. Private to backend/llvm.
+//
+// Two functions per tape, both loops over a batch:
+//   void <name>_box(const double* boxes, i64 n, double* out, u64* stats)     (box_codegen.cpp)
+//     boxes: n groups of `inputs` intervals (lo, hi); out: n intervals; stats: ir::EvalStats.
+//     The caller holds upward rounding and passes only boxes without empty coordinates.
+//   void <name>_point(const double* coords, i64 n, double* out, u64* stats)   (round to nearest)
+//
+// Interval code mirrors runtime/numeric/interval.cpp operation for operation (the same IEEE
+// operations in the same order, the same comparisons deciding ties of signed zeros), rounded upward
+// by constrained intrinsics or AVX-512 embedded rounding, so that no pass may fold, reorder or merge
+// a floating-point operation under the assumption of round-to-nearest. Lower bounds are computed as
+// -RU(-x op y). Complex operations call the numeric core (helpers.hpp).
+#pragma once
+
+#include "backend/llvm/tables.hpp"
+#include "ir/evaluator.hpp"
+#include "ir/tape.hpp"
+
+#include <memory>
+#include <string>
+
+namespace llvm {
+class LLVMContext;
+class Module;
+} // namespace llvm
+
+namespace frac::jit {
+
+// How the interval code rounds upward: LLVM's constrained intrinsics (portable; the caller sets MXCSR),
+// or AVX-512 instructions with embedded rounding ({ru-sae}) where the host has them.
+enum class Rounding { constrained, avx512 };
+
+struct GeneratedNames {
+    std::string box, point;
+};
+
+// Emits both functions into `module` (whose data layout and triple the caller has set).
+GeneratedNames generate(const ir::Tape& tape, const ir::EvalOptions& options, const Tables& tables,
+                        llvm::Module& module, const std::string& name, Rounding rounding, int lanes);
+
+} // namespace frac::jit

@@ -1,0 +1,109 @@
+#include "backend/llvm/helpers.hpp"
+
+#include "ir/graph.hpp"
+#include "ir/semantics.hpp"
+#include "ir/series_tail.hpp"
+#include "runtime/numeric/interval.hpp"
+
+#include <cmath>
+
+using frac::jit::CInterval;
+namespace num = frac::num;
+
+namespace {
+CInterval out(num::Interval v) { return {v.lo, v.hi}; }
+} // namespace
+
+extern "C" {
+
+CInterval frac_jit_div(double alo, double ahi, double blo, double bhi) noexcept {
+    return out(num::div({alo, ahi}, {blo, bhi}));
+}
+CInterval frac_jit_pow(double alo, double ahi, double blo, double bhi) noexcept {
+    return out(num::pow({alo, ahi}, {blo, bhi}));
+}
+CInterval frac_jit_atan2(double ylo, double yhi, double xlo, double xhi) noexcept {
+    return out(num::atan2({ylo, yhi}, {xlo, xhi}));
+}
+CInterval frac_jit_sqrt(double lo, double hi) noexcept { return out(num::sqrt({lo, hi})); }
+CInterval frac_jit_sin(double lo, double hi) noexcept { return out(num::sin({lo, hi})); }
+CInterval frac_jit_cos(double lo, double hi) noexcept { return out(num::cos({lo, hi})); }
+CInterval frac_jit_tan(double lo, double hi) noexcept { return out(num::tan({lo, hi})); }
+CInterval frac_jit_exp(double lo, double hi) noexcept { return out(num::exp({lo, hi})); }
+CInterval frac_jit_log(double lo, double hi) noexcept { return out(num::log({lo, hi})); }
+CInterval frac_jit_powi(double lo, double hi, std::int64_t n) noexcept { return out(num::powi({lo, hi}, n)); }
+
+void frac_jit_vop(int op, std::int64_t imm, const double* in, double* out, std::uint32_t mask, int lanes) noexcept {
+    const auto o = static_cast<frac::ir::Op>(op);
+    const int arity = frac::ir::arity(o);
+    for (int l = 0; l < lanes; ++l) {
+        num::Interval r(0.0);
+        if (mask >> l & 1) {
+            num::Interval args[3];
+            for (int k = 0; k < arity; ++k) args[k] = {in[2 * k * lanes + l], in[(2 * k + 1) * lanes + l]};
+            r = frac::ir::apply_interval(o, args, imm);
+        }
+        out[l] = r.lo;
+        out[lanes + l] = r.hi;
+    }
+}
+
+void frac_jit_vtail(int kind, const double* in, const std::int64_t* n, double* out, int has_b, double gamma_lo,
+                    double gamma_hi, std::uint32_t mask, int lanes) noexcept {
+    const auto o = static_cast<frac::ir::Op>(kind);
+    for (int l = 0; l < lanes; ++l) {
+        num::Interval r(0.0);
+        if (mask >> l & 1)
+            r = frac::ir::series_tail(o, {in[l], in[lanes + l]}, {in[2 * lanes + l], in[3 * lanes + l]}, has_b != 0,
+                                      {gamma_lo, gamma_hi}, n[l]);
+        out[l] = r.lo;
+        out[lanes + l] = r.hi;
+    }
+}
+
+double frac_jit_pow_point(double x, double y) noexcept { return std::pow(x, y); }
+double frac_jit_sin_point(double x) noexcept { return std::sin(x); }
+double frac_jit_cos_point(double x) noexcept { return std::cos(x); }
+double frac_jit_tan_point(double x) noexcept { return std::tan(x); }
+double frac_jit_exp_point(double x) noexcept { return std::exp(x); }
+double frac_jit_log_point(double x) noexcept { return std::log(x); }
+double frac_jit_atan2_point(double y, double x) noexcept { return std::atan2(y, x); }
+
+CInterval frac_jit_series_tail(int kind, double alo, double ahi, double blo, double bhi, int has_b, double gamma_lo,
+                               double gamma_hi, std::int64_t n) noexcept {
+    return out(frac::ir::series_tail(static_cast<frac::ir::Op>(kind), {alo, ahi}, {blo, bhi}, has_b != 0,
+                                     {gamma_lo, gamma_hi}, n));
+}
+
+double frac_jit_point_series_end(int kind, double acc, double a, double b, int has_b, double gamma_lo,
+                                 double gamma_hi, std::int64_t n) noexcept {
+    const auto op = static_cast<frac::ir::Op>(kind);
+    num::Interval tail;
+    {
+        num::UpwardRounding up;
+        tail = frac::ir::series_tail(op, num::Interval(a), has_b ? num::Interval(b) : num::Interval(0.0), has_b != 0,
+                                     {gamma_lo, gamma_hi}, n);
+    }
+    if (!std::isfinite(tail.lo) || !std::isfinite(tail.hi)) return acc;
+    return frac::ir::series_combine_point(op, acc, num::midpoint(tail));
+}
+
+} // extern "C"
+
+namespace frac::jit {
+
+const std::vector<Helper>& helpers() {
+#define FRAC_HELPER(fn) Helper{#fn, reinterpret_cast<void*>(&fn)}
+    static const std::vector<Helper> list = {
+        FRAC_HELPER(frac_jit_div),       FRAC_HELPER(frac_jit_pow),       FRAC_HELPER(frac_jit_atan2),
+        FRAC_HELPER(frac_jit_sqrt),      FRAC_HELPER(frac_jit_sin),       FRAC_HELPER(frac_jit_cos),
+        FRAC_HELPER(frac_jit_tan),       FRAC_HELPER(frac_jit_exp),       FRAC_HELPER(frac_jit_log),
+        FRAC_HELPER(frac_jit_powi),      FRAC_HELPER(frac_jit_pow_point), FRAC_HELPER(frac_jit_sin_point),
+        FRAC_HELPER(frac_jit_cos_point), FRAC_HELPER(frac_jit_tan_point), FRAC_HELPER(frac_jit_exp_point),
+        FRAC_HELPER(frac_jit_log_point), FRAC_HELPER(frac_jit_atan2_point), FRAC_HELPER(frac_jit_series_tail), FRAC_HELPER(frac_jit_point_series_end), FRAC_HELPER(frac_jit_vop), FRAC_HELPER(frac_jit_vtail),
+    };
+#undef FRAC_HELPER
+    return list;
+}
+
+} // namespace frac::jit

@@ -1,0 +1,61 @@
+// The functions generated code calls for the operations it does not inline: thin extern "C" wrappers
+// of the numeric core (interval forms, called under upward rounding) and of the C library (point forms,
+// called in round to nearest), exactly as the interpreter calls them. No LLVM here.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace frac::jit {
+
+// Interval results come back as a C struct of two doubles (returned in two registers on x86-64 and
+// AArch64, which is how the generated code declares them: { double, double }).
+struct CInterval {
+    double lo, hi;
+};
+
+struct Helper {
+    const char* name;
+    void* address;
+};
+// Every helper, for registering their addresses with the JIT.
+const std::vector<Helper>& helpers();
+
+} // namespace frac::jit
+
+extern "C" {
+// Interval operations (upward rounding active): a = [alo, ahi], b = [blo, bhi].
+frac::jit::CInterval frac_jit_div(double alo, double ahi, double blo, double bhi) noexcept;
+frac::jit::CInterval frac_jit_pow(double alo, double ahi, double blo, double bhi) noexcept;
+frac::jit::CInterval frac_jit_atan2(double ylo, double yhi, double xlo, double xhi) noexcept;
+frac::jit::CInterval frac_jit_sqrt(double lo, double hi) noexcept;
+frac::jit::CInterval frac_jit_sin(double lo, double hi) noexcept;
+frac::jit::CInterval frac_jit_cos(double lo, double hi) noexcept;
+frac::jit::CInterval frac_jit_tan(double lo, double hi) noexcept;
+frac::jit::CInterval frac_jit_exp(double lo, double hi) noexcept;
+frac::jit::CInterval frac_jit_log(double lo, double hi) noexcept;
+frac::jit::CInterval frac_jit_powi(double lo, double hi, std::int64_t n) noexcept;
+// Vector code: ir::apply_interval(op, args, imm) for each lane l < lanes whose bit is set in `mask`.
+// in: for each operand k, lanes lower bounds then lanes upper bounds (in[2 k lanes + l], in[(2 k + 1) lanes + l]);
+// out: lanes lower bounds, then lanes upper bounds (lanes outside the mask get 0).
+void frac_jit_vop(int op, std::int64_t imm, const double* in, double* out, std::uint32_t mask, int lanes) noexcept;
+// ir::series_tail per lane: in holds A.lo, A.hi, B.lo, B.hi (lanes each), n the index of each lane.
+void frac_jit_vtail(int kind, const double* in, const std::int64_t* n, double* out, int has_b, double gamma_lo,
+                    double gamma_hi, std::uint32_t mask, int lanes) noexcept;
+// Point operations (round to nearest), the C library's functions as the interpreter calls them.
+double frac_jit_pow_point(double x, double y) noexcept;
+double frac_jit_sin_point(double x) noexcept;
+double frac_jit_cos_point(double x) noexcept;
+double frac_jit_tan_point(double x) noexcept;
+double frac_jit_exp_point(double x) noexcept;
+double frac_jit_log_point(double x) noexcept;
+double frac_jit_atan2_point(double y, double x) noexcept;
+// ir::series_tail(kind, A, B, has_b, gamma, n) (upward rounding active).
+frac::jit::CInterval frac_jit_series_tail(int kind, double alo, double ahi, double blo, double bhi, int has_b,
+                                          double gamma_lo, double gamma_hi, std::int64_t n) noexcept;
+// The end of a series in point evaluation after index n: the partial result `acc` combined with the
+// midpoint of ir::series_tail's enclosure for A = [a, a], B = [b, b] (computed under upward rounding,
+// which it sets and restores itself), or `acc` alone when that tail is unbounded.
+double frac_jit_point_series_end(int kind, double acc, double a, double b, int has_b, double gamma_lo,
+                                 double gamma_hi, std::int64_t n) noexcept;
+}

@@ -1,0 +1,138 @@
+// JIT against the interpreter on one tape: bit-identical box enclosures, point values and series term
+// counts, box by box, point by point and in batches.
+#pragma once
+
+#include "engines.hpp"
+
+namespace frac::test {
+
+struct CrossCheckResult {
+    std::size_t boxes = 0, points = 0, box_mismatches = 0, point_mismatches = 0, stat_mismatches = 0;
+    std::string first; // description of the first mismatch
+};
+
+// The code generator's variants: the host's default and each rounding form at several widths.
+inline std::vector<jit::JitConfig> jit_configs() {
+    using R = jit::JitConfig::Rounding;
+    std::vector<jit::JitConfig> c = {{R::automatic, 0}, {R::constrained, 1}, {R::constrained, 4}};
+    if (jit::host_has_avx512()) {
+        c.push_back({R::avx512, 1});
+        c.push_back({R::constrained, 8});
+    }
+    return c;
+}
+
+inline std::string describe(const jit::JitConfig& c) {
+    const char* r = c.rounding == jit::JitConfig::Rounding::automatic     ? "automatic"
+                    : c.rounding == jit::JitConfig::Rounding::constrained ? "constrained"
+                                                                          : "avx512";
+    return std::string(r) + " x" + std::to_string(c.lanes);
+}
+
+inline CrossCheckResult cross_check(const ir::Tape& tape, const std::vector<Interval>& range, std::uint64_t seed,
+                                    std::size_t count, const ir::EvalOptions& options = {},
+                                    bool with_empty = true, const jit::JitConfig& config = {}) {
+    CrossCheckResult r;
+    auto in = interp::make_interpreter(tape, options);
+    auto jt = jit::make_jit(tape, options, config);
+    const int d = tape.inputs;
+    BoxMaker mk(seed);
+    std::vector<Interval> all;
+    std::vector<double> all_points;
+    auto note = [&](const std::string& what) {
+        if (r.first.empty()) r.first = what;
+    };
+    for (std::size_t n = 0; n < count; ++n) {
+        std::vector<Interval> b = mk.box(range);
+        if (with_empty && d > 0 && mk.pick(64) == 0) b[static_cast<std::size_t>(mk.pick(d))] = Interval::empty();
+        all.insert(all.end(), b.begin(), b.end());
+        in->stats = {};
+        jt->stats = {};
+        const Interval ri = in->eval_box(b.data());
+        const Interval rj = jt->eval_box(b.data());
+        ++r.boxes;
+        if (!same(ri, rj)) {
+            ++r.box_mismatches;
+            note("box " + hex_box(b.data(), d) + ": interp " + hex(ri) + ", jit " + hex(rj));
+        }
+        if (in->stats.series_terms != jt->stats.series_terms || in->stats.series_capped != jt->stats.series_capped ||
+            in->stats.calls != jt->stats.calls) {
+            ++r.stat_mismatches;
+            note("box " + hex_box(b.data(), d) + ": terms interp " + std::to_string(in->stats.series_terms) +
+                 " jit " + std::to_string(jt->stats.series_terms) + ", capped " +
+                 std::to_string(in->stats.series_capped) + " / " + std::to_string(jt->stats.series_capped));
+        }
+        const std::vector<double> p = mk.point(range);
+        all_points.insert(all_points.end(), p.begin(), p.end());
+        in->stats = {};
+        jt->stats = {};
+        const double pi = in->eval_point(p.data());
+        const double pj = jt->eval_point(p.data());
+        ++r.points;
+        if (!same(pi, pj)) {
+            ++r.point_mismatches;
+            std::string at;
+            for (double v : p) at += hex(v) + " ";
+            note("point " + at + ": interp " + hex(pi) + ", jit " + hex(pj));
+        }
+        if (in->stats.series_terms != jt->stats.series_terms || in->stats.series_capped != jt->stats.series_capped) {
+            ++r.stat_mismatches;
+            note("point: terms differ");
+        }
+    }
+    // The same boxes and points as one batch each.
+    std::vector<Interval> oi(count), oj(count);
+    in->stats = {};
+    jt->stats = {};
+    in->eval_boxes(all.data(), count, oi.data());
+    jt->eval_boxes(all.data(), count, oj.data());
+    for (std::size_t n = 0; n < count; ++n)
+        if (!same(oi[n], oj[n])) {
+            ++r.box_mismatches;
+            note("batch box " + std::to_string(n) + ": interp " + hex(oi[n]) + ", jit " + hex(oj[n]));
+        }
+    if (in->stats.series_terms != jt->stats.series_terms || in->stats.series_capped != jt->stats.series_capped ||
+        in->stats.calls != jt->stats.calls) {
+        ++r.stat_mismatches;
+        note("batch: stats differ");
+    }
+    std::vector<double> pi(count), pj(count);
+    in->eval_points(all_points.data(), count, pi.data());
+    jt->eval_points(all_points.data(), count, pj.data());
+    for (std::size_t n = 0; n < count; ++n)
+        if (!same(pi[n], pj[n])) {
+            ++r.point_mismatches;
+            note("batch point " + std::to_string(n) + ": interp " + hex(pi[n]) + ", jit " + hex(pj[n]));
+        }
+    return r;
+}
+
+// cross_check for every code generator variant (the box and point counts are split among them).
+inline CrossCheckResult cross_check_all(const ir::Tape& tape, const std::vector<Interval>& range, std::uint64_t seed,
+                                        std::size_t count, const ir::EvalOptions& options = {}) {
+    CrossCheckResult total;
+    const auto configs = jit_configs();
+    for (std::size_t k = 0; k < configs.size(); ++k) {
+        // The default variant gets the most boxes; the others a share each.
+        const std::size_t n = k == 0 ? count : std::max<std::size_t>(count / 4, 16);
+        const CrossCheckResult r = cross_check(tape, range, seed + 7919 * k, n, options, true, configs[k]);
+        total.boxes += r.boxes;
+        total.points += r.points;
+        total.box_mismatches += r.box_mismatches;
+        total.point_mismatches += r.point_mismatches;
+        total.stat_mismatches += r.stat_mismatches;
+        if (total.first.empty() && !r.first.empty()) total.first = describe(configs[k]) + ": " + r.first;
+    }
+    return total;
+}
+
+#define FRAC_REQUIRE_IDENTICAL(result)                                                                        \
+    do {                                                                                                      \
+        const auto& r_ = (result);                                                                           \
+        INFO(r_.first);                                                                                       \
+        CHECK(r_.box_mismatches == 0);                                                                        \
+        CHECK(r_.point_mismatches == 0);                                                                      \
+        CHECK(r_.stat_mismatches == 0);                                                                       \
+    } while (0)
+
+} // namespace frac::test

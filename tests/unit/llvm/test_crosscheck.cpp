@@ -1,0 +1,156 @@
+// The JIT computes what the interpreter computes, bit for bit: every standard-library shape, an
+// expression for every opcode, random expression graphs, and the options that change series.
+#include "crosscheck.hpp"
+
+#include "ir/graph.hpp"
+
+#include <set>
+
+using namespace frac;
+using namespace frac::test;
+
+namespace {
+
+std::vector<Interval> default_range(int d) { return std::vector<Interval>(static_cast<std::size_t>(d), {-2, 2}); }
+
+} // namespace
+
+TEST_CASE("every stdlib shape: JIT and interpreter agree bit for bit", "[llvm][crosscheck]") {
+    std::set<std::string> seen;
+    for (const std::string& file : stdlib_files()) {
+        const Model m = compile("import \"" + file + "\";");
+        for (std::size_t i = 0; i < m.tapes.size(); ++i) {
+            const front::ShapeInfo& s = m.shape(i);
+            if (!seen.insert(s.name).second) continue; // imported by an earlier file
+            INFO(file << ": shape " << s.name);
+            FRAC_REQUIRE_IDENTICAL(cross_check_all(m.tapes[i], s.box, 1000 + i, 1500));
+        }
+    }
+}
+
+TEST_CASE("series options: fixed term counts and small term limits agree", "[llvm][crosscheck]") {
+    const Model m = compile("import \"fractals\"; import \"koch\";");
+    for (int variant = 0; variant < 3; ++variant) {
+        ir::EvalOptions o;
+        if (variant == 0) o.adaptive_terms = false;
+        if (variant == 1) o.max_terms = 3;
+        if (variant == 2) {
+            o.max_terms = 1;
+            o.adaptive_terms = false;
+        }
+        for (std::size_t i = 0; i < m.tapes.size(); ++i) {
+            INFO("variant " << variant << ": shape " << m.shape(i).name);
+            FRAC_REQUIRE_IDENTICAL(cross_check_all(m.tapes[i], m.shape(i).box, 77 + i, 300, o));
+        }
+    }
+}
+
+TEST_CASE("an expression for every opcode agrees", "[llvm][crosscheck]") {
+    // Each line is a shape over x, y; together they use every arithmetic and logic opcode, with
+    // operands of every sign (the default range is [-2, 2] and BoxMaker goes beyond it).
+    const char* exprs[] = {
+        "x + y", "x - y", "x * y", "x / y", "1 / x", "-x", "x^2", "x^3", "x^4", "x^-1", "x^-2", "x^0 + y",
+        "x^y", "abs(x)^y", "x^0.5", "pow(abs(x), 1/3)", "sqrt(x)", "sqrt(x^2 + y^2)", "abs(x - y)", "min(x, y)",
+        "max(x, y)", "min(x, 1, y)", "floor(x * 3)", "ceil(y / 3)", "mod(x, 1)", "mod(3 * x, 1) - y", "dz(x)",
+        "dz(5 * x + y)", "sin(x)", "cos(3 * y)", "tan(x)", "exp(x)", "log(x)", "log(abs(x) + y)", "atan2(y, x)",
+        "if x < y then x else y", "if x <= y then x * x else -y", "if x > 0 then 1 else -1",
+        "if x >= y and y > 0 then x else y", "if x == y then 1 else 0", "if x != 0.5 or y < 0 then x else 2",
+        "if not (x < y) then x else y + 1", "if x < 0 then sqrt(x) else log(y)", "x / (y - y)", "x / 0",
+        "(x - 1) / (y * y)", "x * 0", "0 * log(x)", "sqrt(-1 - x * x)", "x^(-3) + y^6", "x * y * x - y^5",
+        "[0.1, 0.2] * x + [-1, 1] / y", "exp(x * 800) - exp(y)", "1e300 * x * x + y", "-x^2 + dz(x * 1e17)",
+    };
+    int k = 0;
+    for (const char* e : exprs) {
+        const Model m = compile(std::string("shape s(x, y) = ") + e + ";");
+        INFO(e);
+        FRAC_REQUIRE_IDENTICAL(cross_check_all(m.tapes[0], default_range(2), 500 + static_cast<std::uint64_t>(k++), 400));
+    }
+}
+
+TEST_CASE("series of every kind agree: finite, infinite, with B, nested, orbits", "[llvm][crosscheck]") {
+    const char* exprs[] = {
+        "sum(i in 0..5, x^i) - y",
+        "min(i in 2..9, dz(2^i * x) - y / i)",
+        "max(i in 0..0, x * i + y)",
+        "y - sum(i in 0.., dz(2^i * x) / 2^i)",
+        "y - sum(i in 1.., floor(i * x) / 2^i)",
+        "y - max(i in 0.., (dz(3^i * x) - 1/3) / 3^i)",
+        "min(i in 0.., (1/3 - min(dz(3^i * x), dz(3^i * y))) / 3^i)",
+        "y - sum(i in 0.., sum(j in 0..3, dz(2^j * x) / 2^j) / 4^i)",
+        "y - sum(i in 0.., sin(2^i * x) * x / 2^i)",
+        "y - sum(i in 1.., i * x / 3^i)",
+        "min(k in 0.., p in orbit((x, y), shrink), (sqrt(p.x^2 + p.y^2) - 0.3) / 2^k)",
+        "min(k in 0.., p in orbit((x, y), swap), (dz(p.x) - 0.5 * dz(p.y)) / 2^k)",
+        "max(k in 0.., p in orbit((x, y), grow), (dz(p.x) - abs(p.y)) / 3^k)",
+    };
+    const std::string maps = "fn shrink(p) = (p.x / 2 + 0.1, p.y / 2); fn swap(p) = (p.y, p.x);"
+                             "fn grow(p) = (3 * p.x, 3 * p.y - 1);";
+    int k = 0;
+    for (const char* e : exprs) {
+        auto c = front::compile_source("t.frac", maps + "shape s(x, y) = " + e + ";");
+        INFO(e);
+        if (!c->ok()) {
+            WARN("not compiled: " << c->diags.render(c->sources));
+            continue;
+        }
+        const ir::Tape t = ir::build_tape(c->module.graph, c->module.shapes[0].root, 2);
+        FRAC_REQUIRE_IDENTICAL(cross_check_all(t, {{0, 1}, {0, 1}}, 900 + static_cast<std::uint64_t>(k), 600));
+        ir::EvalOptions o;
+        o.max_terms = 4;
+        FRAC_REQUIRE_IDENTICAL(cross_check_all(t, {{-1, 1}, {-1, 1}}, 950 + static_cast<std::uint64_t>(k++), 200, o));
+    }
+}
+
+namespace {
+
+// Random expression graphs over x, y with every non-series opcode and constants of every kind.
+ir::NodeId random_node(ir::Graph& g, BoxMaker& mk, int depth) {
+    using ir::Op;
+    if (depth == 0 || mk.pick(6) == 0) {
+        switch (mk.pick(6)) {
+        case 0: return g.var(0);
+        case 1: return g.var(1);
+        case 2: {
+            const double vals[] = {0.0, -0.0, 1.0, -1.0, 0.5, 3.0, 1e-310, 1e300, num::inf, -num::inf, 0.1, 2.75};
+            return g.constant(vals[mk.pick(12)]);
+        }
+        case 3: return g.constant(Interval{-mk.uniform(0, 2), mk.uniform(0, 2)}, 0.0);
+        case 4: return g.constant(Interval{0.0, 1.0}, 0.5);
+        default: return g.var(mk.pick(2));
+        }
+    }
+    static const Op ops[] = {Op::Add,   Op::Sub,  Op::Mul,  Op::Div,   Op::Neg,  Op::Sqr, Op::PowI, Op::Pow,
+                             Op::Sqrt,  Op::Abs,  Op::Min,  Op::Max,   Op::Floor, Op::Ceil, Op::Mod1, Op::Dz,
+                             Op::Sin,   Op::Cos,  Op::Tan,  Op::Exp,   Op::Log,  Op::Atan2, Op::Lt,  Op::Le,
+                             Op::Gt,    Op::Ge,   Op::Eq,   Op::Ne,    Op::And,  Op::Or,  Op::Not,  Op::Select};
+    const Op op = ops[mk.pick(static_cast<int>(std::size(ops)))];
+    const int n = ir::arity(op);
+    ir::NodeId a[3] = {ir::no_node, ir::no_node, ir::no_node};
+    for (int k = 0; k < n; ++k) a[k] = random_node(g, mk, depth - 1);
+    const std::int64_t imm = op == Op::PowI ? mk.pick(9) - 4 : 0;
+    return g.op(op, a[0], a[1], a[2], imm);
+}
+
+} // namespace
+
+TEST_CASE("random expression graphs agree", "[llvm][crosscheck]") {
+    BoxMaker mk(4242);
+    for (int n = 0; n < 300; ++n) {
+        ir::Graph g;
+        const ir::NodeId root = random_node(g, mk, 5);
+        const ir::Tape t = ir::build_tape(g, root, 2);
+        INFO("graph " << n << ":\n" << ir::print_tape(t));
+        FRAC_REQUIRE_IDENTICAL(cross_check_all(t, default_range(2), 7000 + static_cast<std::uint64_t>(n), 60));
+    }
+}
+
+TEST_CASE("closed expressions (no coordinates) agree", "[llvm][crosscheck]") {
+    ir::Graph g;
+    const ir::NodeId root = g.op(ir::Op::Add, g.constant(1.0), g.constant(Interval{0.1, 0.2}, 0.15));
+    const ir::Tape t = ir::build_tape(g, root, 0);
+    auto in = interp::make_interpreter(t);
+    auto jt = jit::make_jit(t);
+    CHECK(jt->dimension() == 0);
+    CHECK(same(in->eval_box(nullptr), jt->eval_box(nullptr)));
+    CHECK(same(in->eval_point(nullptr), jt->eval_point(nullptr)));
+}
