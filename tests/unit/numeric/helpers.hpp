@@ -42,3 +42,20 @@ inline bool tight(Interval a, long double v, int ulps = 2) {
 }
 
 } // namespace frac::num::test
+
+// What every numeric test file uses.
+#include <limits>
+namespace num = frac::num;
+using frac::num::test::down;
+using frac::num::test::encloses;
+using frac::num::test::tight;
+using frac::num::test::up;
+using num::inf;
+using num::Interval;
+using num::UpwardRounding;
+
+namespace {
+constexpr double dmax = std::numeric_limits<double>::max();
+const Interval E = Interval::empty();
+const Interval R = Interval::entire();
+} // namespace

@@ -6,20 +6,6 @@
 #include <stdexcept>
 #include <vector>
 
-namespace num = frac::num;
-using frac::num::test::down;
-using frac::num::test::encloses;
-using frac::num::test::tight;
-using frac::num::test::up;
-using num::inf;
-using num::Interval;
-using num::UpwardRounding;
-
-namespace {
-constexpr double dmax = std::numeric_limits<double>::max();
-const Interval E = Interval::empty();
-const Interval R = Interval::entire();
-} // namespace
 
 TEST_CASE("UpwardRounding sets upward rounding and restores the previous mode", "[numeric][rounding]") {
     REQUIRE(std::fegetround() == FE_TONEAREST);

@@ -3,18 +3,7 @@
 
 #include <limits>
 
-namespace num = frac::num;
-using frac::num::test::down;
-using frac::num::test::encloses;
-using frac::num::test::tight;
-using frac::num::test::up;
-using num::inf;
-using num::Interval;
-using num::UpwardRounding;
-
 namespace {
-constexpr double dmax = std::numeric_limits<double>::max();
-const Interval R = Interval::entire();
 
 constexpr long double sin1 = 0.841470984807896506652502321630298999622563L;
 constexpr long double cos1 = 0.540302305868139717400936607442976603732310L;
