@@ -607,8 +607,21 @@ Report check_soundness(std::uint64_t n_pairs, std::uint64_t seed, int num_vars, 
         report.first_violation = s + "\n  enclosure " + fmt_interval(enc) + "\n";
     };
 
+    const std::uint64_t boxes_per_expr = static_cast<std::uint64_t>(std::max(1, options.boxes_per_expr));
+    const std::uint64_t exprs_per_block = static_cast<std::uint64_t>(std::max(1, options.exprs_per_block));
+    std::vector<Expr> block;
+    std::uint64_t next_in_block = 0;
     for (std::uint64_t pair = 0; pair < n_pairs; ++pair) {
-        const Expr e = random_expr(rng, options.max_depth, num_vars);
+        if (pair % boxes_per_expr == 0 && next_in_block == block.size()) {
+            const std::uint64_t remaining = (n_pairs - pair + boxes_per_expr - 1) / boxes_per_expr;
+            block.clear();
+            for (std::uint64_t k = 0; k < std::min(exprs_per_block, remaining); ++k)
+                block.push_back(random_expr(rng, options.max_depth, num_vars));
+            next_in_block = 0;
+            if (options.prepare) options.prepare(block);
+        }
+        const Expr& e = block[next_in_block];
+        if (pair % boxes_per_expr == boxes_per_expr - 1) ++next_in_block;
         const std::vector<num::Interval> box = random_box(rng, num_vars);
         std::array<std::uint64_t, kNumOps> counts{};
         count_ops(e, counts);

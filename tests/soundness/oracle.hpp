@@ -106,6 +106,14 @@ struct Options {
     int max_depth = 4;
     int points_per_pair = 4; // point 0: lower corner, 1: upper corner, 2: centre, then random points
     int bits = 128;
+    // Engines that compile (the JIT) check many boxes per expression and compile many expressions at
+    // once: expressions are drawn `exprs_per_block` at a time and handed to `prepare` before any of their
+    // pairs is evaluated; each expression is then paired with `boxes_per_expr` boxes. The Expr that the
+    // enclosure receives is an element of the vector `prepare` saw. With 1 and 1 the drawing is the same
+    // as one expression and one box per pair.
+    int boxes_per_expr = 1;
+    int exprs_per_block = 1;
+    std::function<void(const std::vector<Expr>&)> prepare;
 };
 
 struct Report {

@@ -4,6 +4,7 @@
 #include "backend/interp/interpreter.hpp"
 #include "ir/semantics.hpp"
 #include "ir/tape.hpp"
+#include "lower_to_ir.hpp"
 #include "oracle.hpp"
 
 #include <chrono>
@@ -14,43 +15,11 @@ using namespace frac;
 
 namespace {
 
-ir::NodeId lower(ir::Graph& g, const oracle::Expr& e) {
-    using oracle::Op;
-    auto arg = [&](std::size_t i) { return lower(g, e.args[i]); };
-    switch (e.op) {
-    case Op::Const: return g.constant(e.value);
-    case Op::Var: return g.var(e.var);
-    case Op::Add: return g.op(ir::Op::Add, arg(0), arg(1));
-    case Op::Sub: return g.op(ir::Op::Sub, arg(0), arg(1));
-    case Op::Mul: return g.op(ir::Op::Mul, arg(0), arg(1));
-    case Op::Div: return g.op(ir::Op::Div, arg(0), arg(1));
-    case Op::Neg: return g.op(ir::Op::Neg, arg(0));
-    case Op::Sqr: return g.op(ir::Op::Sqr, arg(0));
-    case Op::PowInt: return g.op(ir::Op::PowI, arg(0), ir::no_node, ir::no_node, e.n);
-    case Op::Pow: return g.op(ir::Op::Pow, arg(0), arg(1));
-    case Op::Sqrt: return g.op(ir::Op::Sqrt, arg(0));
-    case Op::Abs: return g.op(ir::Op::Abs, arg(0));
-    case Op::Min: return g.op(ir::Op::Min, arg(0), arg(1));
-    case Op::Max: return g.op(ir::Op::Max, arg(0), arg(1));
-    case Op::Floor: return g.op(ir::Op::Floor, arg(0));
-    case Op::Ceil: return g.op(ir::Op::Ceil, arg(0));
-    case Op::Mod1: return g.op(ir::Op::Mod1, arg(0));
-    case Op::Dz: return g.op(ir::Op::Dz, arg(0));
-    case Op::Sin: return g.op(ir::Op::Sin, arg(0));
-    case Op::Cos: return g.op(ir::Op::Cos, arg(0));
-    case Op::Tan: return g.op(ir::Op::Tan, arg(0));
-    case Op::Exp: return g.op(ir::Op::Exp, arg(0));
-    case Op::Log: return g.op(ir::Op::Log, arg(0));
-    case Op::Atan2: return g.op(ir::Op::Atan2, arg(0), arg(1));
-    }
-    std::abort();
-}
-
 constexpr int num_vars = 2;
 
 num::Interval interpret(const oracle::Expr& e, const num::Interval* box) {
     ir::Graph g;
-    const ir::NodeId root = lower(g, e);
+    const ir::NodeId root = oracle::lower_to_ir(g, e);
     auto eval = interp::make_interpreter(ir::build_tape(g, root, num_vars));
     return eval->eval_box(box);
 }
@@ -58,7 +27,7 @@ num::Interval interpret(const oracle::Expr& e, const num::Interval* box) {
 // The interpreter with rounding left at nearest: what an engine that forgot to set the mode would do.
 num::Interval interpret_without_rounding(const oracle::Expr& e, const num::Interval* box) {
     ir::Graph g;
-    const ir::NodeId root = lower(g, e);
+    const ir::NodeId root = oracle::lower_to_ir(g, e);
     const ir::Tape t = ir::build_tape(g, root, num_vars);
     std::vector<num::Interval> slots(t.num_slots);
     for (const auto& c : t.constants) slots[c.slot] = c.value;
