@@ -31,7 +31,10 @@ struct Value {
     ValueKind kind = ValueKind::scalar;
     std::vector<NodeId> nodes;
     std::vector<Interval> box;
-    const Item* shape = nullptr; // a shape used as a value (enclose, dimension)
+    const Item* shape = nullptr; // a shape used as a value (enclose, dimension), or passed as a function
+    // A function passed as an argument (resolve_names checked its uses): inlined where it is called.
+    const Item* function = nullptr;
+    const Builtin* builtin = nullptr;
 
     static Value scalar(NodeId n) { return {ValueKind::scalar, {n}, {}, nullptr}; }
     static Value boolean(NodeId n) { return {ValueKind::boolean, {n}, {}, nullptr}; }
@@ -261,6 +264,7 @@ private:
     // ---- expressions ----
     NodeId scalar(const Value& v, Location loc) {
         if (v.shape) fail(loc, "a shape is not a number here; call it with coordinates");
+        if (v.function || v.builtin) fail(loc, "a function is not a number here; call it with arguments");
         if (v.kind == ValueKind::interval) return g_.constant(v.box[0], num::midpoint(v.box[0]));
         if (v.kind != ValueKind::scalar)
             fail(loc, fmt::format("expected a number, found {}", kind_name(v.kind)));
@@ -338,32 +342,47 @@ private:
         if (auto g = globals_.find(e.text); g != globals_.end()) {
             const Item& it = *g->second;
             if (it.kind == ItemKind::const_) return const_value(it, e.loc);
-            if (it.kind == ItemKind::shape) {
-                Value v;
-                v.shape = &it;
-                return v;
-            }
-            fail(e.loc, fmt::format("'{}' is a function; call it with arguments", e.text));
+            Value v;
+            (it.kind == ItemKind::shape ? v.shape : v.function) = &it;
+            return v;
         }
         if (e.text == "pi") return Value::scalar(g_.constant(num::pi(), M_PI));
         if (e.text == "e") return Value::scalar(g_.constant(num::e(), M_E));
+        if (const Builtin* b = find_builtin(e.text)) {
+            Value v;
+            v.builtin = b;
+            return v;
+        }
         throw InternalError(fmt::format("unresolved name '{}'", e.text));
     }
 
     Value call(const Expr& e) {
-        if (auto g = globals_.find(e.text); g != globals_.end()) {
-            const Item& it = *g->second;
-            if (it.kind == ItemKind::fn) {
-                Scope params;
-                for (std::size_t i = 0; i < it.params.size(); ++i)
-                    params.emplace_back(it.params[i].name, expr(*e.args[i].value));
-                return inline_body(it, std::move(params), e.loc, frames_.back().ctx);
-            }
-            if (it.kind == ItemKind::shape) return Value::scalar(call_shape(it, e));
-            throw InternalError("call of a non-function");
+        if (const Value* local = lookup_local(e.text)) { // a function parameter
+            const Value f = *local;
+            if (f.function) return call_item(*f.function, e);
+            if (f.shape) return Value::scalar(call_shape(*f.shape, e));
+            if (f.builtin) return call_builtin(*f.builtin, e);
+            fail(e.loc, fmt::format("'{}' is a value, not a function", e.text));
         }
+        if (auto g = globals_.find(e.text); g != globals_.end()) return call_item(*g->second, e);
         const Builtin* b = find_builtin(e.text);
         if (!b) throw InternalError(fmt::format("unresolved function '{}'", e.text));
+        return call_builtin(*b, e);
+    }
+
+    Value call_item(const Item& it, const Expr& e) {
+        if (it.kind == ItemKind::fn) {
+            Scope params;
+            for (std::size_t i = 0; i < it.params.size(); ++i)
+                params.emplace_back(it.params[i].name, expr(*e.args[i].value));
+            return inline_body(it, std::move(params), e.loc, frames_.back().ctx);
+        }
+        if (it.kind == ItemKind::shape) return Value::scalar(call_shape(it, e));
+        throw InternalError("call of a non-function");
+    }
+
+    Value call_builtin(const Builtin& builtin, const Expr& e) {
+        const Builtin* b = &builtin;
         auto arg = [&](std::size_t i) { return scalar(expr(*e.args[i].value), e.args[i].loc); };
         switch (b->kind) {
         case BuiltinKind::unary: return Value::scalar(g_.op(b->op, arg(0)));
@@ -615,7 +634,13 @@ private:
             Value state;
             state.kind = ValueKind::point;
             for (int c = 0; c < data.state_count; ++c) state.nodes.push_back(g_.state(data.level, c));
-            const Item& map = *globals_.at(e.orbit_map);
+            const Value* local_map = lookup_local(e.orbit_map); // a function parameter
+            if (local_map && !local_map->function)
+                fail(e.orbit_loc,
+                     fmt::format("the map of an orbit must be a function of a point defined with "
+                                 "'fn'; '{}' is bound to a builtin or a shape",
+                                 e.orbit_map));
+            const Item& map = local_map ? *local_map->function : *globals_.at(e.orbit_map);
             const Value next =
                 inline_body(map, {{map.params[0].name, state}}, e.orbit_loc, frames_.back().ctx);
             if (next.kind != ValueKind::point || next.nodes.size() != state.nodes.size())
