@@ -78,6 +78,7 @@ private:
             f();
         } catch (const CompileError& e) {
             d_.error(e.loc, e.what());
+            for (const auto& [loc, message] : e.notes) d_.note(loc, message);
         } catch (const AlreadyReported&) {
         }
     }
@@ -250,7 +251,17 @@ private:
                 s.pop_back();
             }
         } pop{frames_, call_stack_};
-        return expr(*it.body);
+        try {
+            return expr(*it.body);
+        } catch (CompileError& e) {
+            // The error is in the body: say which calls inlined it (a shape's own definition is no call).
+            constexpr std::size_t max_call_notes = 8;
+            if (call_loc.line != it.loc.line || call_loc.column != it.loc.column) {
+                if (e.notes.size() < max_call_notes)
+                    e.notes.emplace_back(call_loc, fmt::format("in this call of '{}'", it.name));
+            }
+            throw;
+        }
     }
 
     const Value* lookup_local(const std::string& name) const {
