@@ -84,19 +84,27 @@ TEST_CASE("lattice_distance_reduced is the distance to the nearest lattice point
 }
 
 TEST_CASE("lattice_distance is exact on centred lattices", "[stdlib][lattice]") {
-    const Model m =
-        compile("import \"lattice\"; shape tri = lattice_distance((x, y), (1, 0), (1/2, sqrt(3) / 2), "
-                "(0, 0)); shape centred = lattice_distance((x, y), (2, 0), (1, 3), (0, 0));");
-    auto tri = m.eval("tri");
-    auto centred = m.eval("centred");
+    // Bases with 2 (b1.b2) / |b1|^2 an integer: odd (two cosets needed) and even, axis-aligned or not.
+    struct Basis {
+        double b1x, b1y, b2x, b2y;
+    };
+    const Basis bases[] = {
+        {1, 0, 0.5, std::sqrt(3) / 2}, {2, 0, 1, 3}, {1, 0, 1, 1.2}, {0.6, 0.8, -0.5, 1.0}};
     std::mt19937_64 rng(5);
     std::uniform_real_distribution<double> pos(-5, 5);
-    for (int k = 0; k < 300; ++k) {
-        const double p[2] = {pos(rng), pos(rng)};
-        const double want_tri = brute_lattice_distance(p[0], p[1], 1, 0, 0.5, std::sqrt(3) / 2);
-        const double want_centred = brute_lattice_distance(p[0], p[1], 2, 0, 1, 3);
-        CHECK(std::fabs(num::midpoint(at_point(*tri, p, 2)) - want_tri) < 1e-12);
-        CHECK(std::fabs(num::midpoint(at_point(*centred, p, 2)) - want_centred) < 1e-12);
+    for (const Basis& b : bases) {
+        const Model m =
+            compile(fmt::format("import \"lattice\"; shape d = lattice_distance((x, y), ({:.17g}, {:.17g}), "
+                                "({:.17g}, {:.17g}), (0, 0));",
+                                b.b1x, b.b1y, b.b2x, b.b2y));
+        auto e = m.eval("d");
+        for (int k = 0; k < 200; ++k) {
+            const double p[2] = {pos(rng), pos(rng)};
+            const double want = brute_lattice_distance(p[0], p[1], b.b1x, b.b1y, b.b2x, b.b2y);
+            INFO("basis (" << b.b1x << ", " << b.b1y << "), (" << b.b2x << ", " << b.b2y << "), point "
+                           << p[0] << ", " << p[1]);
+            CHECK(std::fabs(num::midpoint(at_point(*e, p, 2)) - want) < 1e-12);
+        }
     }
 }
 
@@ -160,7 +168,7 @@ TEST_CASE("noise enclosures shrink with the box, also across the lattice", "[std
             const ir::Interval ev = v->eval_box(box);
             const ir::Interval en = n->eval_box(box);
             INFO("centre " << c << ", half-width " << w);
-            CHECK(ev.hi - ev.lo < 40 * w + 1e-8); // Lipschitz: about 20 w at worst here
+            CHECK(ev.hi - ev.lo < 40 * w + 1e-8);                     // Lipschitz: about 20 w at worst here
             CHECK(en.hi - en.lo < 200 * w * std::log2(1 / w) + 1e-8); // b = a: ~ w log(1/w)
         }
     }
