@@ -115,13 +115,16 @@ TEST_CASE("noise, lattice and eq. (12) enclosures meet every sampled point's enc
         shape n2 = noise2((x, y));
         shape n3(x, y, z) = noise3((x, y, z));
         shape v3(x, y, z) = value_noise3((x, y, z));
+        shape g1 = fractal_sum(x, gradient_noise1, 2, 1.5) + y;
+        shape g2 = gradient_noise2((x, y));
+        shape g3(x, y, z) = gradient_noise3((x, y, z));
         shape tri = lattice_distance((x, y), (1, 0), (1/2, sqrt(3) / 2), (0.1, 0.2));
         shape skew = lattice_distance_reduced((x, y), (1, 0.2), (0.2, 1.3), (0.3, 0));
         shape koch = koch_general((x, y));
         shape dust = cantor_dust_general((x, y));)");
     std::mt19937_64 rng(6);
     std::uniform_real_distribution<double> unit(0, 1);
-    for (const char* name : {"n1", "n2", "n3", "v3", "tri", "skew", "koch", "dust"}) {
+    for (const char* name : {"n1", "n2", "n3", "v3", "g1", "g2", "g3", "tri", "skew", "koch", "dust"}) {
         auto e = m.eval(name);
         const int dim = m.dimension(name);
         int checked = 0;
