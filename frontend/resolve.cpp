@@ -109,6 +109,12 @@ private:
             changed |= infer(*e.kids[0]);
             shadows_.pop_back();
             return changed;
+        case ExprKind::lambda:
+            shadows_.emplace_back();
+            for (const Binding& b : e.bindings) shadows_.back().insert(b.name);
+            changed |= infer(*e.kids[0]);
+            shadows_.pop_back();
+            return changed;
         case ExprKind::series:
             changed |= infer(*e.kids[0]);
             if (e.kids[1]) changed |= infer(*e.kids[1]);
@@ -218,6 +224,10 @@ private:
             scopes_.pop_back();
             return;
         }
+        case ExprKind::lambda:
+            d_.error(e.loc, "an anonymous function is an argument where a function is expected (a parameter "
+                            "that the callee calls)");
+            return;
         case ExprKind::unary:
         case ExprKind::binary:
         case ExprKind::if_:
@@ -304,8 +314,21 @@ private:
                         plural(arity), param);
         if (!a.name.empty()) d_.error(a.loc, fmt::format("'{}' takes no named arguments", callee));
         const Expr& v = *a.value;
+        if (v.kind == ExprKind::lambda) {
+            const int given = static_cast<int>(v.bindings.size());
+            if (given != arity)
+                d_.error(v.loc, fmt::format("{}, but this function takes {} argument{}", expected, given,
+                                            plural(given)));
+            scopes_.emplace_back();
+            for (const Binding& b : v.bindings)
+                if (!scopes_.back().emplace(b.name, value).second)
+                    d_.error(b.loc, fmt::format("parameter '{}' appears twice", b.name));
+            expr(*v.kids[0]);
+            scopes_.pop_back();
+            return;
+        }
         if (v.kind != ExprKind::name) {
-            d_.error(v.loc, expected + "; pass the name of a function");
+            d_.error(v.loc, expected + "; pass the name of a function, or fn (...) = ...");
             expr(v);
             return;
         }

@@ -60,6 +60,7 @@ TEST_CASE("every grammar production parses", "[grammar]") {
         {"series orbit", "fn f(x) = min(k in 0..2, q in orbit((x, x), m), q.x);",
          "(fn f (x) (min k 0 2 (orbit q (point x x) m) (. x q)))\n"},
         {"call of a function parameter", "fn ap(f, x) = f(x, sqrt);", "(fn ap (f x) (call f x sqrt))\n"},
+        {"lambda", "const c = ap(fn (t, u) = t + u, 1);", "(const c (call ap (fn (t u) (+ t u)) 1))\n"},
         {"comments", "// line\n/* block */ const c = 1; // end", "(const c 1)\n"},
     };
     for (const Case& c : cases) {
