@@ -23,6 +23,7 @@ enum class ExprKind {
     interval, // kids: lo, hi
     series,   // text: sum | min | max; var; kids: start, end (null if infinite), body,
               // and for an orbit series (orbit_var in orbit(kids[3], orbit_map)) the initial point
+    lambda,   // fn (a, b) = body, an argument: bindings: the parameters (values null); kids[0]: body
 };
 
 struct Expr;

@@ -61,6 +61,11 @@ std::string print_expr(const Expr& e) {
     case ExprKind::tuple: return fmt::format("(point{})", kids());
     case ExprKind::field: return fmt::format("(. {}{})", e.text, kids());
     case ExprKind::interval: return fmt::format("(interval{})", kids());
+    case ExprKind::lambda: {
+        std::string names;
+        for (const Binding& b : e.bindings) names += (names.empty() ? "" : " ") + b.name;
+        return fmt::format("(fn ({}){})", names, kids());
+    }
     case ExprKind::series:
         if (!e.orbit_var.empty())
             return fmt::format("({} {} {} {} (orbit {} {} {}) {})", e.text, e.var, print_expr(*e.kids[0]),

@@ -37,11 +37,18 @@ void Diagnostics::note(Location loc, std::string message) {
 }
 
 std::string Diagnostics::render(const SourceManager& sm) const {
-    std::vector<Diagnostic> sorted = list_;
-    std::stable_sort(sorted.begin(), sorted.end(), [](const Diagnostic& a, const Diagnostic& b) {
-        return std::tie(a.loc.file, a.loc.line, a.loc.column) <
-               std::tie(b.loc.file, b.loc.line, b.loc.column);
+    // Sorted by location, each note kept after the diagnostic it explains (it may point elsewhere).
+    std::vector<std::vector<Diagnostic>> groups;
+    for (const Diagnostic& d : list_) {
+        if (d.severity != Severity::note || groups.empty()) groups.emplace_back();
+        groups.back().push_back(d);
+    }
+    std::stable_sort(groups.begin(), groups.end(), [](const auto& a, const auto& b) {
+        return std::tie(a[0].loc.file, a[0].loc.line, a[0].loc.column) <
+               std::tie(b[0].loc.file, b[0].loc.line, b[0].loc.column);
     });
+    std::vector<Diagnostic> sorted;
+    for (const auto& g : groups) sorted.insert(sorted.end(), g.begin(), g.end());
     std::string out;
     for (const Diagnostic& d : sorted) {
         const char* kind = d.severity == Severity::error     ? "error"

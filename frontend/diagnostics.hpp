@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace frac::front {
@@ -61,6 +62,7 @@ private:
 // A located user error that aborts the current item (collected into Diagnostics by the caller).
 struct CompileError : std::runtime_error {
     Location loc;
+    std::vector<std::pair<Location, std::string>> notes; // e.g. the calls that inlined the failing body
     CompileError(Location l, const std::string& message) : std::runtime_error(message), loc(l) {}
 };
 

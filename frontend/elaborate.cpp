@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fmt/format.h>
+#include <memory>
 #include <optional>
 #include <unordered_map>
 #include <unordered_set>
@@ -26,15 +27,36 @@ const char* kind_name(ValueKind k) {
     return "a value";
 }
 
+struct Closure;
+
 // A typed value during elaboration.
 struct Value {
     ValueKind kind = ValueKind::scalar;
     std::vector<NodeId> nodes;
     std::vector<Interval> box;
-    const Item* shape = nullptr; // a shape used as a value (enclose, dimension)
+    const Item* shape = nullptr; // a shape used as a value (enclose, dimension), or passed as a function
+    // A function passed as an argument (resolve_names checked its uses): inlined where it is called.
+    const Item* function = nullptr;
+    const Builtin* builtin = nullptr;
+    std::shared_ptr<const Closure> closure; // an anonymous function
 
-    static Value scalar(NodeId n) { return {ValueKind::scalar, {n}, {}, nullptr}; }
-    static Value boolean(NodeId n) { return {ValueKind::boolean, {n}, {}, nullptr}; }
+    static Value of(ValueKind kind, NodeId n) {
+        Value v;
+        v.kind = kind;
+        v.nodes = {n};
+        return v;
+    }
+    static Value scalar(NodeId n) { return of(ValueKind::scalar, n); }
+    static Value boolean(NodeId n) { return of(ValueKind::boolean, n); }
+};
+
+using Scope = std::vector<std::pair<std::string, Value>>;
+
+// An anonymous function with the scopes it was written in. It is only ever an argument, so it is
+// called while those scopes (and the series whose indices they hold) are still active.
+struct Closure {
+    const Expr* lambda;
+    std::vector<Scope> scopes;
 };
 
 // Where an expression is elaborated: what it may use.
@@ -75,6 +97,7 @@ private:
             f();
         } catch (const CompileError& e) {
             d_.error(e.loc, e.what());
+            for (const auto& [loc, message] : e.notes) d_.note(loc, message);
         } catch (const AlreadyReported&) {
         }
     }
@@ -212,7 +235,11 @@ private:
     }
 
     // ---- scopes and inlining ----
-    using Scope = std::vector<std::pair<std::string, Value>>;
+    struct Frame {
+        Context ctx;
+        std::vector<Scope> scopes;
+        int level = 0; // series nesting
+    };
 
     Value closed(const Expr& e, Context ctx) {
         Frame f{ctx, {}, 0};
@@ -233,12 +260,22 @@ private:
                      fmt::format("recursive call of '{}': functions are inlined, so recursion is not "
                                  "supported (write a series instead)",
                                  it.name));
-        if (static_cast<int>(call_stack_.size()) >= limits_.max_inline_depth)
-            fail(call_loc, fmt::format("calls nested deeper than the limit of {}", limits_.max_inline_depth));
         // A body sees its parameters and the globals; series levels continue from the caller's.
         const int level = frames_.empty() ? 0 : frames_.back().level;
-        frames_.push_back(Frame{ctx, {std::move(params)}, level});
-        call_stack_.push_back(&it);
+        // A shape's own definition is no call: no note for it.
+        const bool is_call = call_loc.line != it.loc.line || call_loc.column != it.loc.column;
+        return inline_expr(*it.body, Frame{ctx, {std::move(params)}, level}, &it, call_loc,
+                           is_call ? fmt::format("in this call of '{}'", it.name) : std::string());
+    }
+
+    // Elaborates an inlined body in its own frame; `item` is null for an anonymous function. An error in
+    // the body gets a note at the call (`call_note`, unless empty).
+    Value inline_expr(const Expr& body, Frame frame, const Item* item, Location call_loc,
+                      const std::string& call_note) {
+        if (static_cast<int>(call_stack_.size()) >= limits_.max_inline_depth)
+            fail(call_loc, fmt::format("calls nested deeper than the limit of {}", limits_.max_inline_depth));
+        frames_.push_back(std::move(frame));
+        call_stack_.push_back(item);
         struct Pop {
             std::vector<Frame>& f;
             std::vector<const Item*>& s;
@@ -247,7 +284,14 @@ private:
                 s.pop_back();
             }
         } pop{frames_, call_stack_};
-        return expr(*it.body);
+        try {
+            return expr(body);
+        } catch (CompileError& e) {
+            constexpr std::size_t max_call_notes = 8;
+            if (!call_note.empty() && e.notes.size() < max_call_notes)
+                e.notes.emplace_back(call_loc, call_note);
+            throw;
+        }
     }
 
     const Value* lookup_local(const std::string& name) const {
@@ -261,6 +305,8 @@ private:
     // ---- expressions ----
     NodeId scalar(const Value& v, Location loc) {
         if (v.shape) fail(loc, "a shape is not a number here; call it with coordinates");
+        if (v.function || v.builtin || v.closure)
+            fail(loc, "a function is not a number here; call it with arguments");
         if (v.kind == ValueKind::interval) return g_.constant(v.box[0], num::midpoint(v.box[0]));
         if (v.kind != ValueKind::scalar)
             fail(loc, fmt::format("expected a number, found {}", kind_name(v.kind)));
@@ -322,6 +368,11 @@ private:
             return r;
         }
         case ExprKind::series: return series(e);
+        case ExprKind::lambda: {
+            Value v;
+            v.closure = std::make_shared<const Closure>(Closure{&e, frames_.back().scopes});
+            return v;
+        }
         }
         throw InternalError("elaborate: unknown expression kind");
     }
@@ -338,32 +389,61 @@ private:
         if (auto g = globals_.find(e.text); g != globals_.end()) {
             const Item& it = *g->second;
             if (it.kind == ItemKind::const_) return const_value(it, e.loc);
-            if (it.kind == ItemKind::shape) {
-                Value v;
-                v.shape = &it;
-                return v;
-            }
-            fail(e.loc, fmt::format("'{}' is a function; call it with arguments", e.text));
+            Value v;
+            (it.kind == ItemKind::shape ? v.shape : v.function) = &it;
+            return v;
         }
         if (e.text == "pi") return Value::scalar(g_.constant(num::pi(), M_PI));
         if (e.text == "e") return Value::scalar(g_.constant(num::e(), M_E));
+        if (const Builtin* b = find_builtin(e.text)) {
+            Value v;
+            v.builtin = b;
+            return v;
+        }
         throw InternalError(fmt::format("unresolved name '{}'", e.text));
     }
 
     Value call(const Expr& e) {
-        if (auto g = globals_.find(e.text); g != globals_.end()) {
-            const Item& it = *g->second;
-            if (it.kind == ItemKind::fn) {
-                Scope params;
-                for (std::size_t i = 0; i < it.params.size(); ++i)
-                    params.emplace_back(it.params[i].name, expr(*e.args[i].value));
-                return inline_body(it, std::move(params), e.loc, frames_.back().ctx);
+        if (const Value* local = lookup_local(e.text)) { // a function parameter
+            const Value f = *local;
+            if (f.function) return call_item(*f.function, e);
+            if (f.shape) return Value::scalar(call_shape(*f.shape, e));
+            if (f.builtin) return call_builtin(*f.builtin, e);
+            if (f.closure) {
+                std::vector<Value> args;
+                for (const Arg& a : e.args) args.push_back(expr(*a.value));
+                return call_closure(*f.closure, std::move(args), e.loc);
             }
-            if (it.kind == ItemKind::shape) return Value::scalar(call_shape(it, e));
-            throw InternalError("call of a non-function");
+            fail(e.loc, fmt::format("'{}' is a value, not a function", e.text));
         }
+        if (auto g = globals_.find(e.text); g != globals_.end()) return call_item(*g->second, e);
         const Builtin* b = find_builtin(e.text);
         if (!b) throw InternalError(fmt::format("unresolved function '{}'", e.text));
+        return call_builtin(*b, e);
+    }
+
+    Value call_closure(const Closure& c, std::vector<Value> args, Location call_loc) {
+        Frame f{frames_.back().ctx, c.scopes, frames_.back().level}; // new series go above the caller's
+        f.scopes.emplace_back();
+        for (std::size_t i = 0; i < args.size(); ++i)
+            f.scopes.back().emplace_back(c.lambda->bindings[i].name, std::move(args[i]));
+        return inline_expr(*c.lambda->kids[0], std::move(f), nullptr, call_loc,
+                           "in this call of the anonymous function");
+    }
+
+    Value call_item(const Item& it, const Expr& e) {
+        if (it.kind == ItemKind::fn) {
+            Scope params;
+            for (std::size_t i = 0; i < it.params.size(); ++i)
+                params.emplace_back(it.params[i].name, expr(*e.args[i].value));
+            return inline_body(it, std::move(params), e.loc, frames_.back().ctx);
+        }
+        if (it.kind == ItemKind::shape) return Value::scalar(call_shape(it, e));
+        throw InternalError("call of a non-function");
+    }
+
+    Value call_builtin(const Builtin& builtin, const Expr& e) {
+        const Builtin* b = &builtin;
         auto arg = [&](std::size_t i) { return scalar(expr(*e.args[i].value), e.args[i].loc); };
         switch (b->kind) {
         case BuiltinKind::unary: return Value::scalar(g_.op(b->op, arg(0)));
@@ -615,9 +695,19 @@ private:
             Value state;
             state.kind = ValueKind::point;
             for (int c = 0; c < data.state_count; ++c) state.nodes.push_back(g_.state(data.level, c));
-            const Item& map = *globals_.at(e.orbit_map);
-            const Value next =
-                inline_body(map, {{map.params[0].name, state}}, e.orbit_loc, frames_.back().ctx);
+            const Value* local_map = lookup_local(e.orbit_map); // a function parameter
+            if (local_map && !local_map->function && !local_map->closure)
+                fail(e.orbit_loc,
+                     fmt::format("the map of an orbit must be a function of a point defined with "
+                                 "'fn'; '{}' is bound to a builtin or a shape",
+                                 e.orbit_map));
+            Value next;
+            if (local_map && local_map->closure) {
+                next = call_closure(*local_map->closure, {state}, e.orbit_loc);
+            } else {
+                const Item& map = local_map ? *local_map->function : *globals_.at(e.orbit_map);
+                next = inline_body(map, {{map.params[0].name, state}}, e.orbit_loc, frames_.back().ctx);
+            }
             if (next.kind != ValueKind::point || next.nodes.size() != state.nodes.size())
                 fail(e.orbit_loc, fmt::format("the map '{}' must return a point of {} coordinates",
                                               e.orbit_map, state.nodes.size()));
@@ -638,12 +728,6 @@ private:
         data.gamma = bound->gamma;
         return Value::scalar(g_.series(kind, data, body, bound->a, bound->b, orbit));
     }
-
-    struct Frame {
-        Context ctx;
-        std::vector<Scope> scopes;
-        int level = 0; // series nesting
-    };
 
     static constexpr std::size_t in_progress = static_cast<std::size_t>(-1);
     static constexpr std::size_t failed = static_cast<std::size_t>(-2);

@@ -55,8 +55,10 @@ private:
         int depth = 0;
         while (!at(Tok::end)) {
             const Tok k = cur().kind;
-            if (depth == 0 && (k == Tok::kw_fn || k == Tok::kw_const || k == Tok::kw_shape ||
-                               k == Tok::kw_test || k == Tok::kw_import || k == Tok::kw_print))
+            const bool anonymous_fn = k == Tok::kw_fn && ahead(1).kind == Tok::lparen; // not an item
+            if (depth == 0 &&
+                ((k == Tok::kw_fn && !anonymous_fn) || k == Tok::kw_const || k == Tok::kw_shape ||
+                 k == Tok::kw_test || k == Tok::kw_import || k == Tok::kw_print))
                 return;
             take();
             if (k == Tok::lbrace) ++depth;
@@ -343,7 +345,7 @@ private:
                         a.name = take().text;
                         take();
                     }
-                    a.value = expr();
+                    a.value = at(Tok::kw_fn) ? lambda() : expr();
                     e->args.push_back(std::move(a));
                 } while (accept(Tok::comma));
                 expect(Tok::rparen, "after the arguments");
@@ -371,8 +373,20 @@ private:
             expect(Tok::rbracket, "to close the interval");
             return e;
         }
+        case Tok::kw_fn:
+            fail("an anonymous function 'fn (...) = ...' is only an argument, where a function is expected");
         default: fail(fmt::format("expected an expression, found {}", describe(tok)));
         }
+    }
+
+    // fn (a, b) = body: an anonymous function, passed as an argument where a function is expected.
+    ExprPtr lambda() {
+        auto e = make(ExprKind::lambda, take().loc);
+        expect(Tok::lparen, "after 'fn' in an anonymous function");
+        for (Param& p : params()) e->bindings.push_back({std::move(p.name), p.loc, nullptr});
+        expect(Tok::assign, "after the parameters of an anonymous function");
+        e->kids.push_back(expr());
+        return e;
     }
 
     // sum(i in a.., body), min(i in a..b, body), max(...)

@@ -2,8 +2,11 @@
 
 #include "frontend/builtins.hpp"
 
+#include <algorithm>
 #include <fmt/format.h>
+#include <optional>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace frac::front {
 
@@ -15,6 +18,7 @@ public:
 
     void run() {
         for (const Item& it : p_.items) declare(it);
+        infer_signatures();
         for (const Item& it : p_.items) check(it);
     }
 
@@ -32,15 +36,116 @@ private:
         }
     }
 
+    // ---- function parameters ----
+    // A parameter of a function is itself a function, of a fixed number of arguments, when the body
+    // calls it, uses it as an orbit's map, or passes it on where a function is expected. Repeated until
+    // nothing changes, as a function may pass a parameter on to one defined after it.
+    static constexpr int value = -1;
+    struct ParamType {
+        int arity = value; // value, or the number of arguments of a function parameter
+        Location first_use;
+    };
+
+    void infer_signatures() {
+        for (const Item& it : p_.items)
+            if (it.kind == ItemKind::fn) signatures_[&it].assign(it.params.size(), ParamType{});
+        for (bool changed = true; changed;) {
+            changed = false;
+            for (const Item& it : p_.items) {
+                if (it.kind != ItemKind::fn) continue;
+                infer_fn_ = &it;
+                shadows_.clear();
+                changed |= infer(*it.body);
+            }
+        }
+        infer_fn_ = nullptr;
+    }
+
+    // Index of an unshadowed parameter of the function being inferred, or -1.
+    int param_index(const std::string& name) const {
+        for (const auto& s : shadows_)
+            if (s.count(name)) return -1;
+        for (std::size_t k = 0; k < infer_fn_->params.size(); ++k)
+            if (infer_fn_->params[k].name == name) return static_cast<int>(k);
+        return -1;
+    }
+
+    bool mark_function(const std::string& name, int arity, Location loc) {
+        const int k = param_index(name);
+        if (k < 0) return false;
+        ParamType& t = signatures_[infer_fn_][static_cast<std::size_t>(k)];
+        if (t.arity != value) return false; // a different arity is reported at the call
+        t.arity = arity;
+        t.first_use = loc;
+        return true;
+    }
+
+    const std::vector<ParamType>* signature(const std::string& callee) const {
+        auto g = globals_.find(callee);
+        if (g == globals_.end() || g->second->kind != ItemKind::fn) return nullptr;
+        return &signatures_.at(g->second);
+    }
+
+    bool infer(const Expr& e) {
+        bool changed = false;
+        switch (e.kind) {
+        case ExprKind::call: {
+            changed |= mark_function(e.text, static_cast<int>(e.args.size()), e.loc);
+            const std::vector<ParamType>* sig = param_index(e.text) < 0 ? signature(e.text) : nullptr;
+            for (std::size_t i = 0; i < e.args.size(); ++i) {
+                const Expr& a = *e.args[i].value;
+                if (sig && i < sig->size() && (*sig)[i].arity != value && a.kind == ExprKind::name)
+                    changed |= mark_function(a.text, (*sig)[i].arity, a.loc);
+                changed |= infer(a);
+            }
+            return changed;
+        }
+        case ExprKind::let:
+            shadows_.emplace_back();
+            for (const Binding& b : e.bindings) {
+                changed |= infer(*b.value);
+                shadows_.back().insert(b.name);
+            }
+            changed |= infer(*e.kids[0]);
+            shadows_.pop_back();
+            return changed;
+        case ExprKind::lambda:
+            shadows_.emplace_back();
+            for (const Binding& b : e.bindings) shadows_.back().insert(b.name);
+            changed |= infer(*e.kids[0]);
+            shadows_.pop_back();
+            return changed;
+        case ExprKind::series:
+            changed |= infer(*e.kids[0]);
+            if (e.kids[1]) changed |= infer(*e.kids[1]);
+            if (!e.orbit_var.empty()) {
+                changed |= infer(*e.kids[3]);
+                changed |= mark_function(e.orbit_map, 1, e.orbit_loc);
+            }
+            shadows_.push_back({e.var, e.orbit_var});
+            changed |= infer(*e.kids[2]);
+            shadows_.pop_back();
+            return changed;
+        default:
+            for (const ExprPtr& k : e.kids)
+                if (k) changed |= infer(*k);
+            return changed;
+        }
+    }
+
+    // ---- checks ----
     void check(const Item& it) {
+        checked_ = &it;
         scopes_.clear();
         scopes_.emplace_back();
-        for (const Param& p : it.params) {
-            if (!scopes_.back().emplace(p.name, 0).second)
+        for (std::size_t k = 0; k < it.params.size(); ++k) {
+            const Param& p = it.params[k];
+            const int arity = it.kind == ItemKind::fn ? signatures_.at(&it)[k].arity : value;
+            if (!scopes_.back().emplace(p.name, arity).second)
                 d_.error(p.loc, fmt::format("parameter '{}' appears twice", p.name));
         }
         if (it.kind == ItemKind::shape && !it.has_params)
-            for (const char* c : {"x", "y", "z"}) scopes_.back().emplace(c, 0);
+            for (const char* c : {"x", "y", "z"}) scopes_.back().emplace(c, value);
         if (it.over) expr(*it.over);
         if (it.body) expr(*it.body);
         for (const Expect& e : it.expects) {
@@ -49,33 +154,43 @@ private:
         }
     }
 
-    bool is_local(const std::string& name) const {
+    // The kind of a local name: `value`, a function parameter's arity, or nullopt when not local.
+    std::optional<int> local(const std::string& name) const {
         for (auto it = scopes_.rbegin(); it != scopes_.rend(); ++it)
-            if (it->count(name)) return true;
-        return false;
+            if (auto found = it->find(name); found != it->end()) return found->second;
+        return std::nullopt;
+    }
+    bool is_local(const std::string& name) const { return local(name).has_value(); }
+
+    // Whether a bare name denotes a function (of the program, a builtin, or a function parameter).
+    bool names_function(const std::string& name) const {
+        if (auto l = local(name)) return *l != value;
+        if (auto g = globals_.find(name); g != globals_.end()) return g->second->kind == ItemKind::fn;
+        return find_builtin(name) != nullptr;
     }
 
     void expr(const Expr& e) {
         switch (e.kind) {
         case ExprKind::number: return;
         case ExprKind::name:
-            if (!is_local(e.text) && !globals_.count(e.text) && !is_builtin_constant(e.text)) {
+            if (names_function(e.text) && !is_builtin_constant(e.text) &&
+                (is_local(e.text) || globals_.count(e.text))) {
+                d_.error(e.loc, fmt::format("'{}' is a function; call it with arguments, or pass it where a "
+                                            "function is expected",
+                                            e.text));
+            } else if (!is_local(e.text) && !globals_.count(e.text) && !is_builtin_constant(e.text)) {
                 if (globals_.count(e.text) == 0 && find_builtin(e.text))
                     d_.error(e.loc, fmt::format("'{}' is a function; call it with arguments", e.text));
                 else
                     d_.error(e.loc, fmt::format("unknown name '{}'", e.text));
             }
             return;
-        case ExprKind::call: {
-            call(e);
-            for (const Arg& a : e.args) expr(*a.value);
-            return;
-        }
+        case ExprKind::call: call(e); return;
         case ExprKind::let: {
             scopes_.emplace_back();
             for (const Binding& b : e.bindings) {
                 expr(*b.value);
-                scopes_.back()[b.name] = 0;
+                scopes_.back()[b.name] = value;
             }
             expr(*e.kids[0]);
             scopes_.pop_back();
@@ -87,7 +202,13 @@ private:
             if (!e.orbit_var.empty()) {
                 expr(*e.kids[3]);
                 auto m = globals_.find(e.orbit_map);
-                if (m == globals_.end() || m->second->kind != ItemKind::fn)
+                if (const std::optional<int> l = local(e.orbit_map)) {
+                    if (*l == value)
+                        d_.error(
+                            e.orbit_loc,
+                            fmt::format("the map of an orbit must be a function of a point, '{}' is a value",
+                                        e.orbit_map));
+                } else if (m == globals_.end() || m->second->kind != ItemKind::fn)
                     d_.error(e.orbit_loc,
                              fmt::format("the map of an orbit must be a function of a point, '{}' is not one",
                                          e.orbit_map));
@@ -97,12 +218,16 @@ private:
                                          e.orbit_map, m->second->params.size()));
             }
             scopes_.emplace_back();
-            scopes_.back()[e.var] = 0;
-            if (!e.orbit_var.empty()) scopes_.back()[e.orbit_var] = 0;
+            scopes_.back()[e.var] = value;
+            if (!e.orbit_var.empty()) scopes_.back()[e.orbit_var] = value;
             expr(*e.kids[2]);
             scopes_.pop_back();
             return;
         }
+        case ExprKind::lambda:
+            d_.error(e.loc, "an anonymous function is an argument where a function is expected (a parameter "
+                            "that the callee calls)");
+            return;
         case ExprKind::unary:
         case ExprKind::binary:
         case ExprKind::if_:
@@ -116,8 +241,35 @@ private:
 
     void call(const Expr& e) {
         const int n = static_cast<int>(e.args.size());
-        if (is_local(e.text)) {
-            d_.error(e.loc, fmt::format("'{}' is a value, not a function", e.text));
+        const std::vector<ParamType>* sig = is_local(e.text) ? nullptr : signature(e.text);
+        for (std::size_t i = 0; i < e.args.size(); ++i) {
+            const Arg& a = e.args[i];
+            if (sig && i < sig->size() && (*sig)[i].arity != value) {
+                function_argument(a, (*sig)[i].arity, e.text, globals_.at(e.text)->params[i].name);
+            } else if (sig && i < sig->size() && a.value->kind == ExprKind::name &&
+                       names_function(a.value->text) && !is_builtin_constant(a.value->text)) {
+                d_.error(a.loc,
+                         fmt::format("'{}' expects a value for its parameter '{}', but '{}' is a function",
+                                     e.text, globals_.at(e.text)->params[i].name, a.value->text));
+            } else {
+                expr(*a.value);
+            }
+        }
+        if (const std::optional<int> l = local(e.text)) {
+            if (*l == value) {
+                d_.error(e.loc, fmt::format("'{}' is a value, not a function", e.text));
+            } else if (*l != n) {
+                d_.error(e.loc, fmt::format("function parameter '{}' takes {} argument{}, {} given", e.text,
+                                            *l, *l == 1 ? "" : "s", n));
+                for (std::size_t k = 0; k < checked_->params.size(); ++k)
+                    if (checked_->params[k].name == e.text)
+                        d_.note(signatures_.at(checked_)[k].first_use,
+                                fmt::format("its number of arguments, {}, comes from this use", *l));
+            } else {
+                for (const Arg& a : e.args)
+                    if (!a.name.empty())
+                        d_.error(a.loc, fmt::format("'{}' takes no named arguments", e.text));
+            }
             return;
         }
         if (auto g = globals_.find(e.text); g != globals_.end()) {
@@ -153,10 +305,88 @@ private:
                 if (!a.name.empty()) d_.error(a.loc, fmt::format("'{}' takes no named arguments", e.text));
     }
 
+    // An argument passed where `callee` expects a function of `arity` arguments: the name of a
+    // function of that arity (of the program, a builtin, a shape, or a function parameter).
+    void function_argument(const Arg& a, int arity, const std::string& callee, const std::string& param) {
+        const auto plural = [](int k) { return k == 1 ? "" : "s"; };
+        const std::string expected =
+            fmt::format("'{}' expects a function of {} argument{} for its parameter '{}'", callee, arity,
+                        plural(arity), param);
+        if (!a.name.empty()) d_.error(a.loc, fmt::format("'{}' takes no named arguments", callee));
+        const Expr& v = *a.value;
+        if (v.kind == ExprKind::lambda) {
+            const int given = static_cast<int>(v.bindings.size());
+            if (given != arity)
+                d_.error(v.loc, fmt::format("{}, but this function takes {} argument{}", expected, given,
+                                            plural(given)));
+            scopes_.emplace_back();
+            for (const Binding& b : v.bindings)
+                if (!scopes_.back().emplace(b.name, value).second)
+                    d_.error(b.loc, fmt::format("parameter '{}' appears twice", b.name));
+            expr(*v.kids[0]);
+            scopes_.pop_back();
+            return;
+        }
+        if (v.kind != ExprKind::name) {
+            d_.error(v.loc, expected + "; pass the name of a function, or fn (...) = ...");
+            expr(v);
+            return;
+        }
+        auto mismatch = [&](int given) {
+            d_.error(v.loc,
+                     fmt::format("{}, but '{}' takes {} argument{}", expected, v.text, given, plural(given)));
+        };
+        if (const std::optional<int> l = local(v.text)) {
+            if (*l == value)
+                d_.error(v.loc, fmt::format("{}, but '{}' is a value", expected, v.text));
+            else if (*l != arity)
+                mismatch(*l);
+            return;
+        }
+        if (auto g = globals_.find(v.text); g != globals_.end()) {
+            const Item& f = *g->second;
+            if (f.kind == ItemKind::const_) {
+                d_.error(v.loc, fmt::format("{}, but '{}' is a constant", expected, v.text));
+            } else if (f.kind == ItemKind::fn) {
+                const auto& sig = signatures_.at(&f);
+                if (std::any_of(sig.begin(), sig.end(), [](const ParamType& t) { return t.arity != value; }))
+                    d_.error(v.loc,
+                             fmt::format("{}, but '{}' takes functions as arguments and cannot be passed "
+                                         "on (function parameters are called with values)",
+                                         expected, v.text));
+                else if (static_cast<int>(f.params.size()) != arity)
+                    mismatch(static_cast<int>(f.params.size()));
+            } else if (f.kind == ItemKind::shape) {
+                const bool fits = arity == 1 || (f.has_params ? arity == static_cast<int>(f.params.size())
+                                                              : arity == 2 || arity == 3);
+                if (!fits)
+                    d_.error(v.loc, fmt::format("{}, but shape '{}' takes a point or its coordinates",
+                                                expected, v.text));
+            }
+            return;
+        }
+        if (const Builtin* b = find_builtin(v.text)) {
+            if (b->kind == BuiltinKind::enclose || b->kind == BuiltinKind::dimension)
+                d_.error(v.loc, fmt::format("{}; '{}' runs a computation on a shape and cannot be passed",
+                                            expected, v.text));
+            else if (arity < b->min_args || arity > b->max_args)
+                mismatch(b->min_args);
+            return;
+        }
+        if (is_builtin_constant(v.text))
+            d_.error(v.loc, fmt::format("{}, but '{}' is a constant", expected, v.text));
+        else
+            d_.error(v.loc, fmt::format("unknown name '{}'", v.text));
+    }
+
     const Program& p_;
     Diagnostics& d_;
     std::unordered_map<std::string, const Item*> globals_;
-    std::vector<std::unordered_map<std::string, int>> scopes_;
+    std::vector<std::unordered_map<std::string, int>> scopes_; // name -> `value` or a function's arity
+    std::unordered_map<const Item*, std::vector<ParamType>> signatures_;
+    const Item* infer_fn_ = nullptr;
+    const Item* checked_ = nullptr; // the item whose body is being checked
+    std::vector<std::unordered_set<std::string>> shadows_;
 };
 
 } // namespace

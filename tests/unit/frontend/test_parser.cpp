@@ -57,6 +57,10 @@ TEST_CASE("every grammar production parses", "[grammar]") {
         {"series infinite", "fn f(x) = sum(i in 0.., x / 2^i);", "(fn f (x) (sum i 0 inf (/ x (^ 2 i))))\n"},
         {"series finite", "fn f(x) = min(k in 1..5, x);", "(fn f (x) (min k 1 5 x))\n"},
         {"max call is not a series", "fn f(x) = max(x, 1);", "(fn f (x) (call max x 1))\n"},
+        {"series orbit", "fn f(x) = min(k in 0..2, q in orbit((x, x), m), q.x);",
+         "(fn f (x) (min k 0 2 (orbit q (point x x) m) (. x q)))\n"},
+        {"call of a function parameter", "fn ap(f, x) = f(x, sqrt);", "(fn ap (f x) (call f x sqrt))\n"},
+        {"lambda", "const c = ap(fn (t, u) = t + u, 1);", "(const c (call ap (fn (t u) (+ t u)) 1))\n"},
         {"comments", "// line\n/* block */ const c = 1; // end", "(const c 1)\n"},
     };
     for (const Case& c : cases) {
