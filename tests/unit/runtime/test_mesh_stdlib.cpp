@@ -67,7 +67,7 @@ std::uint64_t pow20(int k) {
 
 TEST_CASE("stdlib sponge: split 3 at depth k proves exactly the 20^k cubes of the level-k sponge",
           "[mesh][stdlib]") {
-    for (int k = 1; k <= 3; ++k) {
+    for (int k = 1; k <= 4; ++k) { // k = 4: 160000 cubes, the mesh of test_mesh.cpp's depth-4 sponge
         INFO("level " << k);
         Compiled m = sponge(k);
         const RssResult r = cover(m, k, true);
@@ -76,13 +76,14 @@ TEST_CASE("stdlib sponge: split 3 at depth k proves exactly the 20^k cubes of th
         // Cell by cell: inside exactly where the digits say the unit cube is kept. Removed cubes touch
         // the sponge, so they are boundary cells, unless they lie in a hole's interior (then outside).
         const Menger digits(k, true);
-        std::uint64_t checked = 0;
+        std::uint64_t checked = 0, wrong = 0;
         for (const Cell& c : r.cells) {
             if (c.level != k) continue;
             ++checked;
-            CHECK((c.cls == CellClass::inside) == digits.kept(c.ix, c.iy, c.iz));
+            wrong += (c.cls == CellClass::inside) != digits.kept(c.ix, c.iy, c.iz);
         }
         CHECK(checked == r.levels[static_cast<std::size_t>(k)].evaluated);
+        CHECK(wrong == 0);
 
         // The mesh is the sponge's: closed, manifold, the sponge's Euler characteristic, and the same
         // vertices and triangles as the mesh of the digit-exact test evaluator's cover.
@@ -103,8 +104,10 @@ TEST_CASE("stdlib sponge: split 3 at depth k proves exactly the 20^k cubes of th
 
         // With the open rule (hi < 0, for boundary covers) the cubes whose faces lie on the surface,
         // where f = 0, are not inside: the closed rule is what makes the solid exact.
-        const RssResult open = cover(m, k, false);
-        CHECK(open.inside < r.inside);
+        if (k <= 3) {
+            const RssResult open = cover(m, k, false);
+            CHECK(open.inside < r.inside);
+        }
     }
 }
 
