@@ -71,8 +71,9 @@ rt::RssProgress terminal_progress() {
 }
 
 rt::RssResult cover(const std::vector<ir::Interval>& box, int depth, int split, bool keep_cells, int threads,
-                    ir::Evaluator& eval) {
+                    ir::Evaluator& eval, bool closed_inside = false) {
     rt::RssOptions ro;
+    ro.closed_inside = closed_inside;
     ro.threads = threads;
     ro.depth = depth;
     ro.split = split;
@@ -173,7 +174,8 @@ int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions&
         throw RunError(fmt::format("shape '{}' is {}D; meshes are of 3D shapes", s.name, s.dimension));
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
-    const rt::RssResult r = cover(box, o.depth, o.split, true, engine.threads, *eval);
+    // A mesh is of the closed solid {f <= 0}: cells whose faces lie on its surface are inside.
+    const rt::RssResult r = cover(box, o.depth, o.split, true, engine.threads, *eval, true);
     const rt::Mesh mesh = rt::mesh_cover(r, selection);
     const rt::MeshCheck check = rt::check_mesh(mesh);
     std::cerr << fmt::format("{}: depth {} split {}: {} cells ({} inside, {} boundary), {} triangles; {}, "

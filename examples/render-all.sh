@@ -27,8 +27,8 @@ render fig13_koch_polar.frac koch_flake 7
 render similitude_disks.frac turned_disks_direct 8
 render_as rough_terrain.frac terrain_profile 9 rough_terrain_profile
 "$frac" mesh "$here/rough_terrain.frac" terrain --depth 6 -o "$out/rough_terrain.stl"
-# The 3D-printable example: a watertight STL of the sponge in its frame.
-"$frac" mesh "$here/menger_frame.frac" sponge_in_frame --depth 4 --split 3 --select cover -o "$out/menger_frame.stl"
+# The 3D-printable example: an exact, watertight STL of the sponge in its collar (every face on the lattice).
+"$frac" mesh "$here/menger_frame.frac" sponge_in_frame --depth 4 --split 3 -o "$out/menger_frame.stl"
 echo
 echo "pictures (left: recursive subdivision process, right: cover) and meshes are in $out:"
 ls -1 "$out" | sed "s|^|  $out/|"

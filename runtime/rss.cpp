@@ -57,10 +57,10 @@ enum class Verdict { inside, outside, undecided };
 
 // See the header for the rules. The NaN test comes first because an interval with a NaN bound
 // also looks "empty" (!(lo <= hi)), and a NaN says nothing about the box.
-Verdict classify(Interval z) {
+Verdict classify(Interval z, bool closed_inside) {
     if (std::isnan(z.lo) || std::isnan(z.hi)) return Verdict::undecided;
     if (z.lo > z.hi) return Verdict::outside; // empty: f undefined on the whole box
-    if (z.hi < 0) return Verdict::inside;
+    if (z.hi < 0 || (closed_inside && z.hi <= 0)) return Verdict::inside;
     if (z.lo > 0) return Verdict::outside;
     return Verdict::undecided;
 }
@@ -206,7 +206,7 @@ private:
         LevelCounts& lc = r_.levels[static_cast<std::size_t>(level_)];
         for (std::size_t j = 0; j < m; ++j) {
             CellClass cls = CellClass::boundary;
-            switch (classify(out_[j])) {
+            switch (classify(out_[j], r_.options.closed_inside)) {
             case Verdict::inside:
                 cls = CellClass::inside;
                 ++lc.inside;

@@ -4,6 +4,8 @@
 //
 // Classification of a cell from the enclosure [lo, hi] of f over its box:
 //  - hi < 0                      -> inside   (f < 0 everywhere on the box)
+//    or, with RssOptions::closed_inside, hi <= 0 -> inside (the closed cell lies in the closed solid
+//    {f <= 0}; it may touch the boundary, so this rule is for solids, not for boundary covers)
 //  - lo > 0                      -> outside  (f > 0 everywhere on the box)
 //  - empty enclosure (lo > hi)   -> outside: f is undefined on the whole box (e.g. sqrt of a
 //                                   negative number), so no point of the box satisfies f < 0 or
@@ -50,6 +52,10 @@ struct RssOptions {
     // Threads evaluating each batch (0: all cores). Each thread has its own clone of the evaluator,
     // and results are placed by cell position, so the output is the same for every thread count.
     int threads = 1;
+    // Inside means hi <= 0 instead of hi < 0: the cell is proven to lie in the closed solid {f <= 0}.
+    // For meshes of solids (cells whose faces lie on the solid's boundary are inside); boundary covers
+    // (pictures, dimension) keep the default, since a cell with hi = 0 may hold boundary points.
+    bool closed_inside = false;
 };
 
 // Hard limits, reported as errors when exceeded. Besides, split^depth must not exceed 2^32 (cell

@@ -1,5 +1,6 @@
 // 3D test evaluators for the mesh and slice tests (test_mesh.cpp, test_slice.cpp): sets of lattice cubes and
-// the Menger sponge, written directly with the numeric core (see shapes.hpp for the style).
+// the Menger sponge, written directly with the numeric core (see shapes.hpp for the style). The digit-exact
+// sponge is the oracle the standard library's menger_lattice is compared with (test_mesh_stdlib.cpp).
 #pragma once
 
 #include "shapes.hpp"

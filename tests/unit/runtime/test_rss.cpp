@@ -17,6 +17,7 @@ using frac::rt::test::Ball;
 using frac::rt::test::Constant;
 using frac::rt::test::Disk;
 using frac::rt::test::HalfDefined;
+using frac::rt::test::HalfPlane;
 using frac::rt::test::NanShape;
 using frac::rt::test::Stripes;
 
@@ -387,6 +388,33 @@ TEST_CASE("rss: trivial shapes and depth 0", "[rss]") {
     CHECK(c.boundary == 1);
     CHECK(c.cells.size() == 1);
     CHECK(c.cells[0].cls == CellClass::boundary);
+}
+
+TEST_CASE("rss: the closed rule counts cells touching the surface as inside", "[rss]") {
+    // f = x - 1/2: the left half [0, 1/2] x [0, 1] is the closed solid {f <= 0}; its cells have hi = 0.
+    HalfPlane f(1, 0, -0.5);
+    RssOptions o = opts(1);
+    const RssResult open = subdivide(f, unit, o);
+    CHECK(open.inside == 0);
+    CHECK(open.boundary == 4);
+    o.closed_inside = true;
+    const RssResult closed = subdivide(f, unit, o);
+    check_consistency(closed);
+    CHECK(closed.inside == 2);
+    CHECK(closed.boundary == 2); // the right cells touch the solid (lo = 0): never outside
+    for (const Cell& c : closed.cells)
+        if (c.level == 1) CHECK((c.cls == CellClass::inside) == (c.ix == 0));
+
+    // f = 0 everywhere: the solid is the whole root; undefined and NaN cells are unchanged.
+    Constant zero(2, 0.0);
+    CHECK(subdivide(zero, square, o).inside == 1);
+    HalfDefined half;
+    const RssResult h = subdivide(half, {{-1.2, 0.8}, {-1.0, 1.0}}, o);
+    CHECK(h.levels[1].outside == 2);
+    NanShape nan(2);
+    const RssResult n = subdivide(nan, square, o);
+    CHECK(n.inside == 0);
+    CHECK(n.boundary == 4);
 }
 
 TEST_CASE("rss: option and box validation", "[rss]") {
