@@ -166,7 +166,7 @@ int run_compile(const std::string& file, const CompileOptions& o) {
     if (std::string problem = check_compile_output(o.output); !problem.empty()) throw RunError(problem);
     jit::AotConfig config;
     config.options.max_terms = o.max_terms;
-    config.cpu = o.cpu == "native" ? jit::AotConfig::Cpu::native : jit::AotConfig::Cpu::generic;
+    config.cpu = o.cpu;
     config.prefix = o.prefix;
     if (!jit::is_c_identifier(config.prefix + "x"))
         throw RunError(fmt::format("--prefix '{}' cannot begin a C identifier", config.prefix));

@@ -94,11 +94,9 @@ int main(int argc, char** argv) {
         ->add_option("--max-terms", compile_options.max_terms,
                      "most terms of an infinite series before its tail bound (baked into the code)")
         ->check(CLI::Range(1, ir::max_terms_limit));
-    compile
-        ->add_option(
-            "--cpu", compile_options.cpu,
-            "generic (default: any CPU of this architecture) or native (this host, AVX-512 if present)")
-        ->check(CLI::IsMember({"generic", "native"}));
+    compile->add_option("--cpu", compile_options.cpu,
+                        "generic (default: any CPU of this architecture), native (this host) or an LLVM CPU "
+                        "name such as x86-64-v3, x86-64-v4");
     compile->add_option("--prefix", compile_options.prefix, "prefix of the exported C names (default frac_)");
 
     try {

@@ -15,6 +15,7 @@
 #include <llvm/IR/LLVMContext.h>
 #include <llvm/IR/LegacyPassManager.h>
 #include <llvm/IR/Module.h>
+#include <llvm/MC/MCSubtargetInfo.h>
 #include <llvm/MC/TargetRegistry.h>
 #include <llvm/Support/FileSystem.h>
 #include <llvm/Support/TargetSelect.h>
@@ -38,8 +39,8 @@ struct Target {
     Rounding rounding = Rounding::constrained;
 };
 
-// A target machine for this host's architecture: its baseline CPU or the host's own. Position-
-// independent code, so that one object serves executables (PIE) and shared libraries.
+// A target machine for this host's architecture and the CPU asked for. Position-independent code,
+// so that one object serves executables (PIE) and shared libraries.
 Target make_target(const AotConfig& config) {
     static const bool initialised =
         !llvm::InitializeNativeTarget() && !llvm::InitializeNativeTargetAsmPrinter();
@@ -50,28 +51,31 @@ Target make_target(const AotConfig& config) {
     const llvm::Target* target = llvm::TargetRegistry::lookupTarget(t.info.triple, error);
     if (!target) throw JitError("LLVM cannot generate code for " + t.info.triple + ": " + error);
     const llvm::Triple triple(t.info.triple);
-    bool avx512 = false, avx = false;
     std::string features;
-    if (config.cpu == AotConfig::Cpu::native) {
+    if (config.cpu == "native") {
         t.info.cpu = llvm::sys::getHostCPUName().str();
         llvm::SubtargetFeatures f;
-        for (const auto& [name, enabled] : llvm::sys::getHostCPUFeatures()) {
-            f.AddFeature(name, enabled);
-            if (enabled && name == "avx512f") avx512 = true;
-            if (enabled && name == "avx") avx = true;
-        }
+        for (const auto& [name, enabled] : llvm::sys::getHostCPUFeatures()) f.AddFeature(name, enabled);
         features = f.getString();
-    } else {
+    } else if (config.cpu == "generic") {
         t.info.cpu = triple.isX86() ? "x86-64" : "generic";
+    } else {
+        t.info.cpu = config.cpu;
     }
-    // The {ru-sae} form only where the target certainly has AVX-512F (as the JIT's automatic choice).
-    t.rounding = avx512 ? Rounding::avx512 : Rounding::constrained;
-    t.info.rounding = avx512 ? "avx512" : "constrained";
-    t.info.lanes = default_lanes(avx512, avx);
     t.machine.reset(target->createTargetMachine(t.info.triple, t.info.cpu, features, llvm::TargetOptions(),
                                                 llvm::Reloc::PIC_, std::nullopt,
                                                 llvm::CodeGenOptLevel::Default));
     if (!t.machine) throw JitError("LLVM cannot create a target machine for " + t.info.triple);
+    const llvm::MCSubtargetInfo* sti = t.machine->getMCSubtargetInfo();
+    if (!sti->isCPUStringValid(t.info.cpu))
+        throw std::invalid_argument("LLVM knows no CPU '" + t.info.cpu + "' for " + t.info.triple +
+                                    " (try generic, native, x86-64-v2, x86-64-v3, x86-64-v4)");
+    // The {ru-sae} form only where the CPU certainly has AVX-512F (as the JIT's automatic choice).
+    const bool avx512 = triple.isX86() && sti->checkFeatures("+avx512f");
+    const bool avx = triple.isX86() && sti->checkFeatures("+avx");
+    t.rounding = avx512 ? Rounding::avx512 : Rounding::constrained;
+    t.info.rounding = avx512 ? "avx512" : "constrained";
+    t.info.lanes = default_lanes(avx512, avx);
     return t;
 }
 

@@ -25,10 +25,11 @@ struct AotShape {
 struct AotConfig {
     // Baked into the code: series term limits and tables are compile-time choices.
     ir::EvalOptions options;
-    // generic: the target's baseline CPU (x86-64: SSE2), interval code with constrained intrinsics,
-    // runs on any machine of the architecture. native: this host's CPU and features, AVX-512 embedded
-    // rounding ({ru-sae}) where the host has AVX-512F (as the JIT chooses).
-    enum class Cpu { generic, native } cpu = Cpu::generic;
+    // "generic": the architecture's baseline CPU (x86-64: SSE2), runs on any machine of the
+    // architecture. "native": this host's CPU and features. Else a CPU name LLVM knows ("x86-64-v3",
+    // "x86-64-v4", "znver4", ...). Where the CPU has AVX-512F the interval code uses embedded rounding
+    // ({ru-sae}, as the JIT on such a host), elsewhere constrained intrinsics.
+    std::string cpu = "generic";
     // The exported names are <prefix><shape>_<function>.
     std::string prefix = "frac_";
 };
@@ -48,7 +49,7 @@ bool is_c_identifier(const std::string& name);
 // Generates, optimises and writes the code of `shapes`: the relocatable object (without the run-time
 // support) to `object_path` and/or the LLVM IR to `llvm_ir_path` (an empty path: not written).
 // Throws JitError (jit.hpp) when LLVM cannot target this host or a file cannot be written,
-// std::invalid_argument for options out of range.
+// std::invalid_argument for options out of range or a CPU LLVM does not know.
 AotInfo compile_aot(const std::vector<AotShape>& shapes, const AotConfig& config,
                     const std::string& object_path, const std::string& llvm_ir_path);
 

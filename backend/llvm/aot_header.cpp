@@ -58,11 +58,11 @@ std::string aot_header(const std::vector<AotShape>& shapes, const AotConfig& con
         config.options.max_terms));
     line(fmt::format(" * proven tail bound encloses the rest (--max-terms); adaptive truncation {}.",
                      config.options.adaptive_terms ? "on" : "off"));
-    line(fmt::format(" * Code: {}, CPU {}, interval code with {}, {} box{} per vector.", info.triple,
-                     info.cpu,
-                     info.rounding == "avx512" ? "AVX-512 embedded rounding {ru-sae} (needs AVX-512F)"
-                                               : "constrained intrinsics (portable)",
-                     info.lanes, info.lanes == 1 ? "" : "es"));
+    line(fmt::format(" * Code: {} for CPU {} (runs on CPUs with its features), interval code with {},",
+                     info.triple, info.cpu,
+                     info.rounding == "avx512" ? "AVX-512 embedded rounding {ru-sae}"
+                                               : "constrained intrinsics"));
+    line(fmt::format(" * {} box{} per vector.", info.lanes, info.lanes == 1 ? "" : "es"));
     line(" */");
     line(fmt::format("#ifndef {}", guard));
     line(fmt::format("#define {}", guard));
