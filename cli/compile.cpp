@@ -110,7 +110,7 @@ void check_writable(const std::string& path) {
     if (!probe) throw RunError(fmt::format("cannot write '{}': {}", path, std::strerror(errno)));
 }
 
-// Removes the files it was given unless the command succeeded: no half-written model is left behind.
+// Removes the files the command created unless it succeeded: no empty or half-written model is left.
 class OutputsOnFailure {
 public:
     void add(const std::string& path) { paths_.push_back(path); }
@@ -186,8 +186,10 @@ int run_compile(const std::string& file, const CompileOptions& o) {
     OutputsOnFailure outputs;
     for (const std::string& path : {o.output, ir_path, o.header}) {
         if (path.empty()) continue;
+        std::error_code ec;
+        const bool existed = fs::exists(path, ec);
         check_writable(path);
-        outputs.add(path);
+        if (!existed) outputs.add(path);
     }
 
     const std::string archive = ir_only ? std::string() : find_runtime_archive();

@@ -276,6 +276,9 @@ TEST_CASE(
 
     JitModel jit = jit_model(model);
     const std::size_t checked = check_example_output(with_object.out, jit);
+    const Run tests = run(std::string(FRAC_BINARY) + " test " + model, dir); // the model's own test block
+    INFO(tests.out << tests.err);
+    CHECK(tests.status == 0);
     CHECK(checked == 5 + 4 + 16 + 16 + 2 + 1 + 64); // every evaluation main.c makes
 }
 
