@@ -24,6 +24,15 @@ struct MeshOptions {
 int run_mesh(const std::string& file, const MeshOptions& options, const EngineOptions& engine);
 int run_dimension(const std::string& file, const std::string& shape, int from, int to, int split,
                   const EngineOptions& engine);
+struct CompileOptions {
+    std::vector<std::string> shapes; // none: every shape of the model
+    std::string output, header, cpu = "generic", prefix = "frac_";
+    bool emit_llvm = false;
+    int max_terms = ir::EvalOptions{}.max_terms;
+};
+// "" when `path` names an output frac compile can write (.o, .so, .ll), else why not.
+std::string check_compile_output(const std::string& path);
+int run_compile(const std::string& file, const CompileOptions& options);
 // Runs the print statements (when `prints`) and the tests of each file; prints "N passed, N failed".
 int run_tests(const std::vector<std::string>& files, bool prints, const EngineOptions& engine);
 

@@ -78,6 +78,27 @@ int main(int argc, char** argv) {
     run->add_option("file", file, "model file")->required();
     add_engine(run);
 
+    cli::CompileOptions compile_options;
+    auto* compile = app.add_subcommand(
+        "compile", "compile shapes to an object file or shared library with a C ABI (docs/c-abi.md)");
+    compile->add_option("file", file, "model file")->required();
+    compile->add_option("shapes", compile_options.shapes, "shapes to compile (default: every shape)");
+    compile->add_option("-o,--output", compile_options.output, "model.o, model.so or model.ll (LLVM IR only)")
+        ->required()
+        ->check(CLI::Validator(cli::check_compile_output, "FILE.o|.so|.ll", "output"));
+    compile->add_option("--header", compile_options.header,
+                        "also write the C header declaring the functions");
+    compile->add_flag("--emit-llvm", compile_options.emit_llvm,
+                      "also write the LLVM IR next to the output (.ll)");
+    compile
+        ->add_option("--max-terms", compile_options.max_terms,
+                     "most terms of an infinite series before its tail bound (baked into the code)")
+        ->check(CLI::Range(1, ir::max_terms_limit));
+    compile->add_option("--cpu", compile_options.cpu,
+                        "generic (default: any CPU of this architecture), native (this host) or an LLVM CPU "
+                        "name such as x86-64-v3, x86-64-v4");
+    compile->add_option("--prefix", compile_options.prefix, "prefix of the exported C names (default frac_)");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -91,6 +112,7 @@ int main(int argc, char** argv) {
         if (*dimension) return cli::run_dimension(file, shape, from, to, split, engine);
         if (*mesh) return cli::run_mesh(file, mesh_options, engine);
         if (*test) return cli::run_tests(files, false, engine);
+        if (*compile) return cli::run_compile(file, compile_options);
         if (*run) return cli::run_tests({file}, true, engine);
     } catch (const cli::RunError& e) {
         std::cerr << "frac: error: " << e.what() << "\n";

@@ -3,6 +3,7 @@
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/codegen.hpp"
 #include "backend/llvm/helpers.hpp"
+#include "backend/llvm/pipeline.hpp"
 #include "backend/llvm/tables.hpp"
 
 #include <llvm/ExecutionEngine/Orc/CompileUtils.h>
@@ -12,8 +13,6 @@
 #include <llvm/ExecutionEngine/Orc/ThreadSafeModule.h>
 #include <llvm/IR/LLVMContext.h>
 #include <llvm/IR/Module.h>
-#include <llvm/IR/Verifier.h>
-#include <llvm/Passes/PassBuilder.h>
 #include <llvm/Support/TargetSelect.h>
 #include <llvm/Support/raw_ostream.h>
 #include <llvm/Target/TargetMachine.h>
@@ -66,7 +65,7 @@ public:
 
     int lanes_for(const JitConfig& c, Rounding r) const {
         int lanes = c.lanes;
-        if (lanes == 0) lanes = avx512 ? 8 : avx ? 4 : 2;
+        if (lanes == 0) lanes = default_lanes(avx512, avx);
         if (lanes != 1 && lanes != 2 && lanes != 4 && lanes != 8 && lanes != 16)
             throw std::invalid_argument("jit: lanes must be 0, 1, 2, 4, 8 or 16");
         if (r == Rounding::avx512 && lanes != 1 && lanes != 8)
@@ -138,28 +137,6 @@ private:
     }
 };
 
-void optimize(llvm::Module& m, llvm::TargetMachine* tm) {
-    llvm::LoopAnalysisManager lam;
-    llvm::FunctionAnalysisManager fam;
-    llvm::CGSCCAnalysisManager cgam;
-    llvm::ModuleAnalysisManager mam;
-    llvm::PassBuilder pb(tm);
-    pb.registerModuleAnalyses(mam);
-    pb.registerCGSCCAnalyses(cgam);
-    pb.registerFunctionAnalyses(fam);
-    pb.registerLoopAnalyses(lam);
-    pb.crossRegisterProxies(lam, fam, cgam, mam);
-    // The generated IR is already SSA with the tape's loop-invariant code hoisted; what it needs is
-    // the counters promoted to registers, common subexpressions shared, constant conditions folded
-    // and the invariant parts of the lanes' work (zero tests of a coordinate ...) hoisted out of
-    // series loops. This pipeline runs at a twentieth of the cost of -O2 and gives the same speed
-    // on the standard library (bench/bench_jit.cpp).
-    llvm::ModulePassManager mpm;
-    if (auto err = pb.parsePassPipeline(mpm, "function(sroa,early-cse,simplifycfg,loop-mssa(licm),early-cse,dce)"))
-        throw std::logic_error("jit: bad pass pipeline: " + to_string(std::move(err)));
-    mpm.run(m, mam);
-}
-
 std::size_t instruction_count(const llvm::Module& m) {
     std::size_t n = 0;
     for (const llvm::Function& f : m)
@@ -174,12 +151,6 @@ std::size_t table_bytes(const Tables& t) {
         n += s.threshold.size() * 8 + s.tail.size() * 16 + s.tail_width.size() * 8 +
              s.gamma_n.size() * 16;
     return n;
-}
-
-void check_options(const ir::Tape& tape, const ir::EvalOptions& options) {
-    if (options.max_terms < 1 || options.max_terms > ir::max_terms_limit)
-        throw std::invalid_argument("max_terms out of range");
-    if (std::string why = ir::verify_tape(tape); !why.empty()) throw std::invalid_argument("malformed tape: " + why);
 }
 
 struct Generated {
@@ -198,9 +169,7 @@ Generated generate_module(const ir::Tape& tape, const ir::EvalOptions& options, 
         g.module->setTargetTriple(engine->jit->getTargetTriple().str());
     }
     g.names = generate(tape, options, tables, *g.module, name, rounding, lanes);
-    std::string problems;
-    llvm::raw_string_ostream os(problems);
-    if (llvm::verifyModule(*g.module, &os)) throw std::logic_error("jit: generated invalid LLVM IR: " + os.str());
+    verify_generated(*g.module);
     return g;
 }
 

@@ -1,0 +1,60 @@
+// Ahead-of-time compilation of shapes to an object file with a C ABI (docs/c-abi.md).
+//
+// The same code generator as the JIT (codegen.hpp) emits each shape's batch functions into one LLVM
+// module; exported C wrappers with stable names are added around them, and LLVM's TargetMachine writes
+// the object. The object still calls the numeric core: `frac compile` links it with
+// libfrac_aot_runtime.a (aot_runtime.hpp, helpers.hpp, the numeric core, LLVM libc), see cli/compile.cpp.
+//
+// Only backend/llvm includes LLVM headers; this header does not.
+#pragma once
+
+#include "ir/evaluator.hpp"
+#include "ir/tape.hpp"
+
+#include <string>
+#include <vector>
+
+namespace frac::jit {
+
+struct AotShape {
+    std::string name; // a C identifier
+    ir::Tape tape;
+    std::vector<ir::Interval> box; // default box, one interval per coordinate
+};
+
+struct AotConfig {
+    // Baked into the code: series term limits and tables are compile-time choices.
+    ir::EvalOptions options;
+    // "generic": the architecture's baseline CPU (x86-64: SSE2), runs on any machine of the
+    // architecture. "native": this host's CPU and features. Else a CPU name LLVM knows ("x86-64-v3",
+    // "x86-64-v4", "znver4", ...). Where the CPU has AVX-512F the interval code uses embedded rounding
+    // ({ru-sae}, as the JIT on such a host), elsewhere constrained intrinsics.
+    std::string cpu = "generic";
+    // The exported names are <prefix><shape>_<function>.
+    std::string prefix = "frac_";
+};
+
+// What the generated code is (for the header's comments and the CLI's summary).
+struct AotInfo {
+    std::string triple, cpu, rounding; // rounding: "constrained" or "avx512"
+    int lanes = 1;
+};
+
+// The exported name of one function of a shape ("eval_point", "eval_box", ...).
+std::string aot_symbol(const AotConfig& config, const std::string& shape, const std::string& function);
+
+// Whether `name` can be part of a C identifier's name (letters, digits, '_', not starting with a digit).
+bool is_c_identifier(const std::string& name);
+
+// Generates, optimises and writes the code of `shapes`: the relocatable object (without the run-time
+// support) to `object_path` and/or the LLVM IR to `llvm_ir_path` (an empty path: not written).
+// Throws JitError (jit.hpp) when LLVM cannot target this host or a file cannot be written,
+// std::invalid_argument for options out of range or a CPU LLVM does not know.
+AotInfo compile_aot(const std::vector<AotShape>& shapes, const AotConfig& config,
+                    const std::string& object_path, const std::string& llvm_ir_path);
+
+// The C header declaring the functions of `shapes` (with comments: layouts, rounding contract, limits).
+std::string aot_header(const std::vector<AotShape>& shapes, const AotConfig& config, const AotInfo& info,
+                       const std::string& source_name, const std::string& guard);
+
+} // namespace frac::jit
