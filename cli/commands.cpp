@@ -1,6 +1,7 @@
 // frac check, eval, render, dimension.
 #include "cli/commands.hpp"
 
+#include "backend/llvm/jit.hpp"
 #include "runtime/dimension.hpp"
 #include "runtime/mesh.hpp"
 #include "runtime/picture.hpp"
@@ -33,6 +34,17 @@ int run_check(const std::string& file, const std::string& emit, const std::strin
         } else if (emit == "tape") {
             std::cout << fmt::format("shape {}:\n{}", s->name,
                                      ir::print_tape(ir::build_tape(m.graph, s->root, s->dimension)));
+        } else if (emit == "llvm") {
+            std::string why;
+            if (!jit::jit_available(&why)) {
+                std::cerr << "frac: error: --emit=llvm needs the LLVM backend, which cannot be used here: "
+                          << why << "\n";
+                return 1;
+            }
+            // The optimised module the JIT compiles for this host (frac compile --emit-llvm writes the
+            // one of a compiled model, with its C entry points).
+            std::cout << fmt::format("; shape {}\n{}", s->name,
+                                     jit::emit_llvm(ir::build_tape(m.graph, s->root, s->dimension)));
         }
     }
     if (emit.empty())

@@ -23,8 +23,8 @@ int main(int argc, char** argv) {
     std::string file, shape, emit, at, box;
     auto* check = app.add_subcommand("check", "parse, check and lower a model; --emit shows a stage");
     check->add_option("file", file, "model file")->required();
-    check->add_option("--emit", emit, "print the ast, the ir graph or the tape")
-        ->check(CLI::IsMember({"ast", "ir", "tape"}));
+    check->add_option("--emit", emit, "print the ast, the ir graph, the tape or the JIT's LLVM IR")
+        ->check(CLI::IsMember({"ast", "ir", "tape", "llvm"}));
     check->add_option("--shape", shape, "only this shape");
 
     auto* eval = app.add_subcommand("eval", "evaluate a shape at a point or over a box");
