@@ -52,6 +52,15 @@ struct RssOptions {
     int threads = 1;
 };
 
+// Min/max pruning (ir/specialize.hpp, switched by EvalOptions::prune): an undecided cell far enough
+// above the depth limit asks its evaluator for a simplified function, which its descendants then
+// evaluate. The cover is the same with and without it (docs/design.md, "Pruning").
+// Pruning is considered for undecided cells at levels k with depth - k >= prune_min_remaining and
+// k a multiple of prune_period: below, too few descendants are left to repay recording the choices
+// (one interpreter evaluation of the cell); between, the choices rarely change (bench/bench_prune).
+inline constexpr int prune_min_remaining = 3;
+inline constexpr int prune_period = 2;
+
 // Hard limits, reported as errors when exceeded. Besides, split^depth must not exceed 2^32 (cell
 // positions are 32-bit): with split 3 the depth is at most 20, with split 4 at most 16.
 inline constexpr int max_depth_2d = 24;
@@ -71,6 +80,9 @@ struct RssResult {
     // Totals over all levels; evaluated = inside + outside + boundary + subdivided.
     std::uint64_t evaluated = 0, inside = 0, outside = 0, boundary = 0, subdivided = 0;
     double seconds = 0; // wall time of subdivide (steady clock)
+    // Pruning: cells evaluated with a simplified function, and how many distinct functions they used.
+    std::uint64_t pruned_evaluations = 0;
+    std::size_t specializations = 0;
 
     // Outward enclosure of a cell's box along `axis`: lo = RD(x0 + (x1-x0)*i/n),
     // hi = RU(x0 + (x1-x0)*(i+1)/n), n = split^level, clamped to the root box. Neighbouring cells
