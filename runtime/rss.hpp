@@ -56,10 +56,11 @@ struct RssOptions {
 // above the depth limit asks its evaluator for a simplified function, which its descendants then
 // evaluate. The cover is the same with and without it (docs/design.md, "Pruning").
 // Pruning is considered for undecided cells at levels k with depth - k >= prune_min_remaining and
-// k a multiple of prune_period: below, too few descendants are left to repay recording the choices
-// (one interpreter evaluation of the cell); between, the choices rarely change (bench/bench_prune).
-inline constexpr int prune_min_remaining = 3;
-inline constexpr int prune_period = 2;
+// k a multiple of prune_period. Closer to the depth too few descendants are left to repay recording
+// the choices (one interpreter evaluation of the cell); measured on bench/csg_scene.frac with both
+// engines (docs/performance.md).
+inline constexpr int prune_min_remaining = 5;
+inline constexpr int prune_period = 1;
 
 // Hard limits, reported as errors when exceeded. Besides, split^depth must not exceed 2^32 (cell
 // positions are 32-bit): with split 3 the depth is at most 20, with split 4 at most 16.

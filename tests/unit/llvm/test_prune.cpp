@@ -279,3 +279,22 @@ TEST_CASE("pruned covers are identical across engines", "[llvm][prune][rss]") {
     CHECK(in->specialize_stats.requests > 0);
     CHECK(jt->specialize_stats.requests == in->specialize_stats.requests);
 }
+
+TEMPLATE_TEST_CASE("a 3D CSG cover is the same with and without pruning", "[llvm][prune][rss]", InterpEngine,
+                   JitEngine) {
+    const Model m = compile(read_file(std::string(FRAC_SOURCE_DIR) + "/examples/menger_frame.frac"));
+    const front::ShapeInfo& s = info_of(m, "sponge_in_frame");
+    ir::EvalOptions off;
+    off.prune = false;
+    auto plain = TestType::make(tape_of(m, "sponge_in_frame"), off);
+    auto pruning = TestType::make(tape_of(m, "sponge_in_frame"));
+    rt::RssOptions o;
+    o.depth = 7; // deep enough for cells prune_min_remaining levels above the depth to be split
+    o.keep_cells = true;
+    o.threads = 2;
+    const rt::RssResult a = rt::subdivide(*plain, s.box, o);
+    const rt::RssResult b = rt::subdivide(*pruning, s.box, o);
+    CHECK(same_cover(a, b));
+    CHECK(pruning->specialize_stats.requests > 0);
+    if (std::string(TestType::name) == "interp") CHECK(b.pruned_evaluations > 0);
+}
