@@ -14,6 +14,13 @@ bool is_choice(Op op) {
     return op == Op::Min || op == Op::Max || op == Op::And || op == Op::Or || op == Op::Select;
 }
 
+bool has_choices(const Tape& tape) {
+    if (tape.blocks.empty()) return false;
+    for (const Instr& ins : tape.blocks[0])
+        if (is_choice(ins.op)) return true;
+    return false;
+}
+
 namespace {
 
 // What the emptiness analysis knows of a slot on every sub-box of the recorded box (and every term).
@@ -141,9 +148,7 @@ bool usable(Interval v) {
 std::vector<Choice> record_choices(const Tape& tape, const Interval* slots) {
     const std::vector<Instr>& main = tape.blocks.at(0);
     std::vector<Choice> choices(main.size(), Choice::both);
-    bool any = false;
-    for (const Instr& ins : main) any |= is_choice(ins.op);
-    if (!any) return choices;
+    if (!has_choices(tape)) return choices;
     const EmptinessAnalysis facts(tape, slots);
     for (std::size_t k = 0; k < main.size(); ++k) {
         const Instr& ins = main[k];

@@ -34,6 +34,8 @@ enum class Choice : std::uint8_t { both, first, second };
 
 // Min, Max, And, Or, Select.
 bool is_choice(Op op);
+// Whether block 0 of the tape has a choice instruction (else nothing can ever be pruned).
+bool has_choices(const Tape& tape);
 
 // The choices of the block-0 instructions (one entry per instruction of tape.blocks[0], `both` for
 // any other) after an interval evaluation of `tape` over a box; `slots` is the evaluator's register

@@ -48,7 +48,7 @@ public:
 
     std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
         auto cache = cache_.lock();
-        if (!cache || !options_.prune) return nullptr;
+        if (!cache || !options_.prune || !ir::has_choices(tape_)) return nullptr;
         const auto t0 = std::chrono::steady_clock::now();
         const std::vector<ir::Choice> choices = record(box);
         specialize_stats.record_ms +=

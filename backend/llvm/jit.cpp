@@ -210,6 +210,7 @@ struct Compiled {
     ir::Tape tape;
     ir::EvalOptions options;
     JitConfig config;
+    bool has_choices = false; // block 0 has min/max/select instructions to prune
     BatchBoxes boxes = nullptr;
     BatchPoints points = nullptr;
     llvm::orc::ResourceTrackerSP tracker;
@@ -239,7 +240,7 @@ public:
     // interpreter's enclosures are the JIT's bit for bit, so both engines prune alike.
     std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
         auto cache = cache_.lock();
-        if (!cache || !code_->options.prune) return nullptr;
+        if (!cache || !code_->options.prune || !code_->has_choices) return nullptr;
         const auto t0 = Clock::now();
         if (!recorder_) recorder_ = std::make_unique<interp::ChoiceRecorder>(code_->tape, code_->options);
         const std::vector<ir::Choice> choices = recorder_->record(box);
@@ -341,6 +342,7 @@ std::shared_ptr<const Compiled> compile(const ir::Tape& tape, const ir::EvalOpti
     code->tape = tape;
     code->options = options;
     code->config = config;
+    code->has_choices = ir::has_choices(tape);
     CompileInfo& info = code->info;
     info.rounding = rounding == Rounding::avx512 ? "avx512" : "constrained";
     info.lanes = lanes;
