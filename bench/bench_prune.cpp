@@ -97,16 +97,6 @@ std::pair<Run, Run> cover_pair(Make make, const Shape& s, int depth, const ir::E
     return runs;
 }
 
-bool same_cover(const rt::RssResult& a, const rt::RssResult& b) {
-    if (a.cells.size() != b.cells.size()) return false;
-    for (std::size_t k = 0; k < a.cells.size(); ++k) {
-        const rt::Cell &x = a.cells[k], &y = b.cells[k];
-        if (x.level != y.level || x.cls != y.cls || x.ix != y.ix || x.iy != y.iy || x.iz != y.iz)
-            return false;
-    }
-    return true;
-}
-
 // Boxes of the cells of a cover (every level), for timing evaluations.
 std::vector<ir::Interval> cell_boxes(const rt::RssResult& r) {
     std::vector<ir::Interval> boxes;
@@ -256,7 +246,7 @@ int main(int argc, char** argv) {
             off.prune = false;
             const int reps = std::string(name) == "jit" ? 3 : 2;
             const auto [a, b] = cover_pair(make, s, d, off, on, reps);
-            const bool same = same_cover(a.result, b.result);
+            const bool same = rt::same_cells(a.result, b.result);
             const double pruned_share =
                 100.0 * double(b.result.pruned_evaluations) / double(b.result.evaluated);
             fmt::print("{:<16} {:<6} {:>5} {:>9} {:>8.3f} {:>8.3f} {:>6.2f}x {:>7.1f}% {:>6} {:>5} {:>5} "

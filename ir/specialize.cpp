@@ -157,16 +157,29 @@ std::vector<Choice> record_choices(const Tape& tape, const Interval* slots) {
         if (!usable(a) || !usable(b)) continue;
         // The dropped operand must not become empty below (it would empty the result).
         const bool keep_a = !facts.may_empty(ins.in[1]), keep_b = !facts.may_empty(ins.in[0]);
+        // Min and max need disjoint operands: where they touch, the result's bounds could be a 0 of
+        // the other operand's sign. On truth values (exactly 0 or 1) and is min and or is max, and
+        // false decides an and, true an or, whatever the other operand.
         switch (ins.op) {
         case Op::Min:
-        case Op::And: // on non-empty truth values, and is min
             if (a.hi < b.lo && keep_a) choices[k] = Choice::first;
             if (b.hi < a.lo && keep_b) choices[k] = Choice::second;
             break;
+        case Op::And:
+            if (a.hi <= b.lo && keep_a)
+                choices[k] = Choice::first;
+            else if (b.hi <= a.lo && keep_b)
+                choices[k] = Choice::second;
+            break;
         case Op::Max:
-        case Op::Or:
             if (a.lo > b.hi && keep_a) choices[k] = Choice::first;
             if (b.lo > a.hi && keep_b) choices[k] = Choice::second;
+            break;
+        case Op::Or:
+            if (a.lo >= b.hi && keep_a)
+                choices[k] = Choice::first;
+            else if (b.lo >= a.hi && keep_b)
+                choices[k] = Choice::second;
             break;
         case Op::Select:
             if (facts.may_empty(ins.in[0])) break;

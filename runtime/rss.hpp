@@ -99,4 +99,8 @@ struct RssResult {
 // root must have 2 or 3 axes, as many as f.dimension(), each finite with lo < hi).
 RssResult subdivide(ir::Evaluator& f, const std::vector<Interval>& root, const RssOptions& options);
 
+// Whether two results recorded the same cells (level, class and position, in the same order): the
+// same cover, e.g. with pruning on and off, or with two engines.
+bool same_cells(const RssResult& a, const RssResult& b);
+
 } // namespace frac::rt

@@ -25,6 +25,7 @@ shape scene(x, y) over [0, 2] × [0, 1] =
         disk((x, y), (1.0, 0.5), 0.05));
 shape chooser(x, y) over [-1, 1] × [-1, 1] = if x < 0 then carpet(x + 1, y) else disk((x, y), (0.5, 0), 0.3);
 shape partial(x, y) over [0, 1] × [-1, 1] = min(x - 10, sqrt(y));
+shape quadrant(x, y) over [-1, 1] × [-1, 1] = if x < 0 and y < 0 then carpet(x + 1, y + 1) else disk((x, y), (0.5, 0), 0.3);
 )";
 
 std::string read_file(const std::string& path) {
@@ -72,16 +73,6 @@ std::vector<std::vector<Interval>> cover_boxes(ir::Evaluator& e, const std::vect
         boxes.push_back(b);
     }
     return boxes;
-}
-
-bool same_cover(const rt::RssResult& a, const rt::RssResult& b) {
-    if (a.cells.size() != b.cells.size()) return false;
-    for (std::size_t k = 0; k < a.cells.size(); ++k) {
-        const rt::Cell &x = a.cells[k], &y = b.cells[k];
-        if (x.level != y.level || x.cls != y.cls || x.ix != y.ix || x.iy != y.iy || x.iz != y.iz)
-            return false;
-    }
-    return true;
 }
 
 } // namespace
@@ -219,6 +210,16 @@ TEMPLATE_TEST_CASE("what pruning must not touch", "[llvm][prune]", InterpEngine,
         const std::vector<Interval> across{{-0.2, 0.2}, {-0.5, 0.5}};
         CHECK_FALSE(e->specialize(across.data(), 1e12));
     }
+    SECTION("a false operand decides an and, whatever the other") {
+        auto e = TestType::make(tape_of(m, "quadrant"));
+        // x < 0 is false, y < 0 unknown: the and is false, the select takes the disk.
+        const std::vector<Interval> box{{0.2, 0.8}, {-0.5, 0.5}};
+        auto p = e->specialize(box.data(), 1e12);
+        REQUIRE(p);
+        CHECK(p->instruction_count() < e->instruction_count() / 2); // the carpet's series is gone
+        const std::vector<Interval> sub{{0.25, 0.3}, {-0.1, 0.4}};
+        CHECK(same(p->eval_box(sub.data()), e->eval_box(sub.data())));
+    }
     SECTION("pruning off") {
         ir::EvalOptions off;
         off.prune = false;
@@ -256,7 +257,7 @@ TEMPLATE_TEST_CASE("RSS covers are the same with and without pruning", "[llvm][p
             o.threads = 2; // pruned variants are evaluated per thread too
             const rt::RssResult a = rt::subdivide(*plain, s.box, o);
             const rt::RssResult b = rt::subdivide(*pruning, s.box, o);
-            CHECK(same_cover(a, b));
+            CHECK(rt::same_cells(a, b));
             CHECK(a.pruned_evaluations == 0);
             pruned_evaluations += b.pruned_evaluations;
         }
@@ -274,7 +275,7 @@ TEST_CASE("pruned covers are identical across engines", "[llvm][prune][rss]") {
     o.depth = 8;
     const rt::RssResult a = rt::subdivide(*in, s.box, o);
     const rt::RssResult b = rt::subdivide(*jt, s.box, o);
-    CHECK(same_cover(a, b));
+    CHECK(rt::same_cells(a, b));
     CHECK(a.pruned_evaluations > a.evaluated / 2);
     CHECK(in->specialize_stats.requests > 0);
     CHECK(jt->specialize_stats.requests == in->specialize_stats.requests);
@@ -294,7 +295,7 @@ TEMPLATE_TEST_CASE("a 3D CSG cover is the same with and without pruning", "[llvm
     o.threads = 2;
     const rt::RssResult a = rt::subdivide(*plain, s.box, o);
     const rt::RssResult b = rt::subdivide(*pruning, s.box, o);
-    CHECK(same_cover(a, b));
+    CHECK(rt::same_cells(a, b));
     CHECK(pruning->specialize_stats.requests > 0);
     if (std::string(TestType::name) == "interp") CHECK(b.pruned_evaluations > 0);
 }
