@@ -246,7 +246,7 @@ int main(int argc, char** argv) {
             off.prune = false;
             const int reps = std::string(name) == "jit" ? 3 : 2;
             const auto [a, b] = cover_pair(make, s, d, off, on, reps);
-            const bool same = rt::same_cells(a.result, b.result);
+            const bool same = rt::same_cover(a.result, b.result);
             const double pruned_share =
                 100.0 * double(b.result.pruned_evaluations) / double(b.result.evaluated);
             fmt::print("{:<16} {:<6} {:>5} {:>9} {:>8.3f} {:>8.3f} {:>6.2f}x {:>7.1f}% {:>6} {:>5} {:>5} "

@@ -378,7 +378,7 @@ RssResult subdivide(ir::Evaluator& f, const std::vector<Interval>& root, const R
     return r;
 }
 
-bool same_cells(const RssResult& a, const RssResult& b) {
+bool same_cover(const RssResult& a, const RssResult& b) {
     return std::equal(
         a.cells.begin(), a.cells.end(), b.cells.begin(), b.cells.end(), [](const Cell& x, const Cell& y) {
             return x.level == y.level && x.cls == y.cls && x.ix == y.ix && x.iy == y.iy && x.iz == y.iz;

@@ -101,6 +101,6 @@ RssResult subdivide(ir::Evaluator& f, const std::vector<Interval>& root, const R
 
 // Whether two results recorded the same cells (level, class and position, in the same order): the
 // same cover, e.g. with pruning on and off, or with two engines.
-bool same_cells(const RssResult& a, const RssResult& b);
+bool same_cover(const RssResult& a, const RssResult& b);
 
 } // namespace frac::rt

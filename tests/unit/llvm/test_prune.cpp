@@ -257,7 +257,7 @@ TEMPLATE_TEST_CASE("RSS covers are the same with and without pruning", "[llvm][p
             o.threads = 2; // pruned variants are evaluated per thread too
             const rt::RssResult a = rt::subdivide(*plain, s.box, o);
             const rt::RssResult b = rt::subdivide(*pruning, s.box, o);
-            CHECK(rt::same_cells(a, b));
+            CHECK(rt::same_cover(a, b));
             CHECK(a.pruned_evaluations == 0);
             pruned_evaluations += b.pruned_evaluations;
         }
@@ -275,7 +275,7 @@ TEST_CASE("pruned covers are identical across engines", "[llvm][prune][rss]") {
     o.depth = 8;
     const rt::RssResult a = rt::subdivide(*in, s.box, o);
     const rt::RssResult b = rt::subdivide(*jt, s.box, o);
-    CHECK(rt::same_cells(a, b));
+    CHECK(rt::same_cover(a, b));
     CHECK(a.pruned_evaluations > a.evaluated / 2);
     CHECK(in->specialize_stats.requests > 0);
     CHECK(jt->specialize_stats.requests == in->specialize_stats.requests);
@@ -295,7 +295,7 @@ TEMPLATE_TEST_CASE("a 3D CSG cover is the same with and without pruning", "[llvm
     o.threads = 2;
     const rt::RssResult a = rt::subdivide(*plain, s.box, o);
     const rt::RssResult b = rt::subdivide(*pruning, s.box, o);
-    CHECK(rt::same_cells(a, b));
+    CHECK(rt::same_cover(a, b));
     CHECK(pruning->specialize_stats.requests > 0);
     if (std::string(TestType::name) == "interp") CHECK(b.pruned_evaluations > 0);
 }
