@@ -251,49 +251,65 @@ private:
         }
     }
 
-    // Evaluates boxes_[0, m) into out_, each cell with its variant's function: cells of one variant
-    // are gathered, evaluated together, and their results put back in place.
+    // Evaluates boxes_[0, m) into out_, each cell with its variant's function: the cells are gathered
+    // by variant, each variant's run is cut into at most one chunk per thread (chunk c of a variant
+    // uses that variant's evaluator c), all chunks run in one parallel loop, and the results are put
+    // back in place.
     void evaluate(std::size_t m) {
+        const auto d = static_cast<std::size_t>(d_);
         bool mixed = false;
         for (std::size_t j = 0; j < m && !mixed; ++j) mixed = queue_[j].variant != queue_[0].variant;
-        const std::uint32_t first = queue_[0].variant;
+        const Interval* boxes = boxes_.data();
+        Interval* out = out_.data();
+        order_.clear();
+        std::vector<std::size_t> starts{0}; // of each variant's run in the gathered order
+        std::vector<std::uint32_t> run_variant;
         if (!mixed) {
-            if (first != 0) r_.pruned_evaluations += m;
-            evaluate_variant(first, boxes_.data(), m, out_.data());
-            return;
+            run_variant.push_back(queue_[0].variant);
+            starts.push_back(m);
+        } else {
+            std::vector<std::vector<std::size_t>> members(variants_.size());
+            for (std::size_t j = 0; j < m; ++j) members[queue_[j].variant].push_back(j);
+            for (std::uint32_t v = 0; v < members.size(); ++v) {
+                if (members[v].empty()) continue;
+                order_.insert(order_.end(), members[v].begin(), members[v].end());
+                run_variant.push_back(v);
+                starts.push_back(order_.size());
+            }
+            group_boxes_.resize(m * d);
+            group_out_.resize(m);
+            for (std::size_t i = 0; i < m; ++i) std::copy_n(&boxes_[order_[i] * d], d, &group_boxes_[i * d]);
+            boxes = group_boxes_.data();
+            out = group_out_.data();
         }
-        const auto d = static_cast<std::size_t>(d_);
-        std::vector<std::vector<std::size_t>> members(variants_.size());
-        for (std::size_t j = 0; j < m; ++j) members[queue_[j].variant].push_back(j);
-        for (std::uint32_t v = 0; v < members.size(); ++v) {
-            const std::vector<std::size_t>& js = members[v];
-            if (js.empty()) continue;
-            if (v != 0) r_.pruned_evaluations += js.size();
-            group_boxes_.resize(js.size() * d);
-            group_out_.resize(js.size());
-            for (std::size_t i = 0; i < js.size(); ++i)
-                std::copy_n(&boxes_[js[i] * d], d, &group_boxes_[i * d]);
-            evaluate_variant(v, group_boxes_.data(), js.size(), group_out_.data());
-            for (std::size_t i = 0; i < js.size(); ++i) out_[js[i]] = group_out_[i];
+        struct Chunk {
+            std::uint32_t variant, worker;
+            std::size_t begin, end;
+        };
+        std::vector<Chunk> chunks;
+        for (std::size_t r = 0; r < run_variant.size(); ++r) {
+            const std::size_t n = starts[r + 1] - starts[r];
+            if (run_variant[r] != 0) r_.pruned_evaluations += n;
+            const auto k = std::max<std::size_t>(1, std::min<std::size_t>(static_cast<std::size_t>(threads_),
+                                                                          (n + min_chunk - 1) / min_chunk));
+            for (std::size_t c = 0; c < k; ++c)
+                chunks.push_back({run_variant[r], static_cast<std::uint32_t>(c), starts[r] + n * c / k,
+                                  starts[r] + n * (c + 1) / k});
         }
-    }
-
-    // Evaluates n boxes with variant v: in one call, or in one contiguous chunk per thread.
-    void evaluate_variant(std::uint32_t v, const Interval* boxes, std::size_t n, Interval* out) {
-        const auto d = static_cast<std::size_t>(d_);
-        const std::vector<ir::Evaluator*>& workers = variants_[v].workers;
-        const auto chunks =
-            std::min<std::size_t>(static_cast<std::size_t>(threads_), (n + min_chunk - 1) / min_chunk);
-        if (chunks <= 1) {
-            workers[0]->eval_boxes(boxes, n, out);
-            return;
-        }
-        arena_.execute([&] {
-            tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
-                const std::size_t begin = n * c / chunks, end = n * (c + 1) / chunks;
-                workers[c]->eval_boxes(boxes + begin * d, end - begin, out + begin);
+        const auto run_chunk = [&](const Chunk& c) {
+            variants_[c.variant].workers[c.worker]->eval_boxes(boxes + c.begin * d, c.end - c.begin,
+                                                               out + c.begin);
+        };
+        if (chunks.size() == 1 || threads_ == 1) {
+            for (const Chunk& c : chunks) run_chunk(c);
+        } else {
+            arena_.execute([&] {
+                tbb::parallel_for(std::size_t{0}, chunks.size(),
+                                  [&](std::size_t i) { run_chunk(chunks[i]); });
             });
-        });
+        }
+        if (mixed)
+            for (std::size_t i = 0; i < m; ++i) out_[order_[i]] = group_out_[i];
     }
 
     // Descendant evaluations of an undecided cell `remaining` levels above the depth, if the
@@ -341,7 +357,8 @@ private:
     };
     std::vector<Variant> variants_;
     std::unordered_map<const ir::Evaluator*, std::uint32_t> variant_of_;
-    std::vector<Interval> group_boxes_, group_out_;
+    std::vector<Interval> group_boxes_, group_out_; // cells gathered by variant
+    std::vector<std::size_t> order_;                // ... their positions in the batch
     std::size_t flush_at_ = 0;
     int level_ = 0;
     std::uint64_t n_ = 1;               // cells per axis at level_
