@@ -226,7 +226,8 @@ struct Compiled {
 
 class JitEvaluator final : public ir::Evaluator {
 public:
-    JitEvaluator(std::shared_ptr<const Compiled> code, std::weak_ptr<ir::SpecializationCache> cache)
+    explicit JitEvaluator(std::shared_ptr<const Compiled> code,
+                          std::weak_ptr<ir::SpecializationCache> cache = {})
         : code_(std::move(code)), cache_(std::move(cache)) {}
 
     int dimension() const override { return code_->tape.inputs; }
@@ -382,8 +383,7 @@ std::shared_ptr<const Compiled> compile(const ir::Tape& tape, const ir::EvalOpti
 
 std::unique_ptr<ir::Evaluator> make_jit(const ir::Tape& tape, const ir::EvalOptions& options,
                                         const JitConfig& config) {
-    auto root = std::make_unique<JitEvaluator>(compile(tape, options, config),
-                                               std::weak_ptr<ir::SpecializationCache>{});
+    auto root = std::make_unique<JitEvaluator>(compile(tape, options, config));
     // Specialisations are compiled like the shape; they refer to the cache weakly (it owns them).
     auto self = std::make_shared<std::weak_ptr<ir::SpecializationCache>>();
     auto cache = std::make_shared<ir::SpecializationCache>(
