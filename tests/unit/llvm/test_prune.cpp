@@ -279,6 +279,14 @@ TEST_CASE("pruned covers are identical across engines", "[llvm][prune][rss]") {
     CHECK(a.pruned_evaluations > a.evaluated / 2);
     CHECK(in->specialize_stats.requests > 0);
     CHECK(jt->specialize_stats.requests == in->specialize_stats.requests);
+    // Which cells evaluate which pruned function does not depend on the thread count.
+    auto in2 = InterpEngine::make(tape_of(m, "csg_scene"));
+    o.threads = 2;
+    const rt::RssResult c = rt::subdivide(*in2, s.box, o);
+    CHECK(rt::same_cover(a, c));
+    CHECK(c.pruned_evaluations == a.pruned_evaluations);
+    CHECK(c.specializations == a.specializations);
+    CHECK(in2->stats.series_terms == in->stats.series_terms);
 }
 
 TEMPLATE_TEST_CASE("a 3D CSG cover is the same with and without pruning", "[llvm][prune][rss]", InterpEngine,
