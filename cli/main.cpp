@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <iostream>
+#include <map>
 
 int main(int argc, char** argv) {
     using namespace frac;
@@ -18,6 +19,9 @@ int main(int argc, char** argv) {
             ->check(CLI::Range(1, ir::max_terms_limit));
         sub->add_option("--threads", engine.threads, "subdivision threads (0: all cores)")
             ->check(CLI::Range(0, 1024));
+        sub->add_option("--prune", engine.eval.prune,
+                        "min/max pruning per region during subdivision: on (default) or off")
+            ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
     };
 
     std::string file, shape, emit, at, box;

@@ -12,4 +12,21 @@ void Evaluator::eval_boxes(const Interval* boxes, std::size_t n, Interval* out) 
     for (std::size_t i = 0; i < n; ++i) out[i] = eval_box(boxes + i * d);
 }
 
+std::shared_ptr<Evaluator> Evaluator::specialize(const Interval*, double) {
+    return nullptr;
+}
+
+SpecializeStats& SpecializeStats::operator+=(const SpecializeStats& o) {
+    requests += o.requests;
+    unpruned += o.unpruned;
+    too_little += o.too_little;
+    declined += o.declined;
+    hits += o.hits;
+    compiled += o.compiled;
+    fallbacks += o.fallbacks;
+    compile_ms += o.compile_ms;
+    record_ms += o.record_ms;
+    return *this;
+}
+
 } // namespace frac::ir

@@ -20,6 +20,9 @@ struct EvalOptions {
     // Stop a series when the box is too wide for further terms to resolve anything (see
     // docs/design.md). Off: sum until the tail is negligible or max_terms (for measurements).
     bool adaptive_terms = true;
+    // Min/max pruning per region (Evaluator::specialize, ir/specialize.hpp). Off: specialize()
+    // returns null, every box evaluates the whole function (`--prune=off`).
+    bool prune = true;
 };
 inline constexpr int max_terms_limit = 100000;
 
@@ -28,6 +31,21 @@ struct EvalStats {
     std::uint64_t calls = 0;         // point or box evaluations
     std::uint64_t series_terms = 0;  // series terms evaluated in total
     std::uint64_t series_capped = 0; // series stopped by the term limit, not by resolution
+};
+
+// What min/max pruning did (ir/specialize.hpp), counted by the evaluator that was asked.
+struct SpecializeStats {
+    std::uint64_t requests = 0;   // specialize() calls that recorded choices over a box
+    std::uint64_t unpruned = 0;   // ... where nothing could be pruned
+    std::uint64_t too_little = 0; // ... where pruning saved less than the rule asks
+    std::uint64_t declined = 0;   // ... where compiling would cost more than it saves (or the cache is full)
+    std::uint64_t hits = 0;       // ... answered by an already compiled specialisation
+    std::uint64_t compiled = 0;   // ... that compiled a new one
+    std::uint64_t fallbacks = 0;  // ... that made a second-tier (interpreted) one, no compile
+    double compile_ms = 0;        // time spent compiling them
+    double record_ms = 0;         // time spent recording choices
+
+    SpecializeStats& operator+=(const SpecializeStats& o);
 };
 
 class Evaluator {
@@ -52,7 +70,17 @@ public:
     // An independent evaluator of the same function, for use on another thread.
     virtual std::unique_ptr<Evaluator> clone() const = 0;
 
+    // Min/max pruning: records which operands the min/max/select instructions take over `box` and,
+    // when the rule of ir/specialize.hpp says it pays for about `expected_evaluations` evaluations
+    // of sub-boxes, returns an evaluator of the simplified function, valid on every sub-box of
+    // `box` (shared and cached: clone it for another thread). Null when nothing is pruned, when it
+    // would not pay, or when the engine does not specialise.
+    virtual std::shared_ptr<Evaluator> specialize(const Interval* box, double expected_evaluations);
+    // Instructions of the function this evaluator computes (its tape).
+    virtual std::size_t instruction_count() const { return 0; }
+
     EvalStats stats;
+    SpecializeStats specialize_stats;
 };
 
 } // namespace frac::ir

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
+#include <unordered_map>
 #include <utility>
 
 namespace frac::rt {
@@ -18,9 +19,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Position of a cell in the grid of its level.
+// Position of a cell in the grid of its level, and the function it evaluates (0: the shape's, else
+// a pruned one, Runner::variants_).
 struct Pos {
     std::uint32_t ix, iy, iz;
+    std::uint32_t variant = 0;
 };
 
 // split^k; exact in 64 bits (and as a double) for split <= 4, k <= 24.
@@ -106,6 +109,9 @@ public:
         num::UpwardRounding up;
         for (const Interval& x : r_.root) width_.push_back(axis_width(x));
         for (int t = 1; t < threads_; ++t) clones_.push_back(f_.clone());
+        variants_.emplace_back();
+        variants_[0].workers.push_back(&f_);
+        for (const auto& c : clones_) variants_[0].workers.push_back(c.get());
         // Each thread gets a batch of its own per flush.
         flush_at_ = r_.options.batch * static_cast<std::size_t>(threads_);
         queue_.reserve(std::min<std::size_t>(flush_at_, 1 << 16));
@@ -113,11 +119,14 @@ public:
 
     ~Runner() {
         // The clones' work counts as the caller's evaluator's.
-        for (const auto& c : clones_) {
-            f_.stats.calls += c->stats.calls;
-            f_.stats.series_terms += c->stats.series_terms;
-            f_.stats.series_capped += c->stats.series_capped;
-        }
+        for (const Variant& v : variants_)
+            for (ir::Evaluator* w : v.workers) {
+                if (w == &f_) continue;
+                f_.stats.calls += w->stats.calls;
+                f_.stats.series_terms += w->stats.series_terms;
+                f_.stats.series_capped += w->stats.series_capped;
+                f_.specialize_stats += w->specialize_stats;
+            }
     }
 
     void run() {
@@ -141,6 +150,7 @@ public:
         }
         r_.boundary = r_.levels[static_cast<std::size_t>(depth)].undecided;
         r_.subdivided = r_.evaluated - r_.inside - r_.outside - r_.boundary;
+        r_.specializations = variants_.size() - 1;
     }
 
 private:
@@ -171,8 +181,8 @@ private:
                     for (std::uint32_t cy = 0; cy < s; ++cy)
                         for (std::size_t p = row; p < row_end; ++p)
                             for (std::uint32_t cx = 0; cx < s; ++cx)
-                                push({parents[p].ix * s + cx, parents[p].iy * s + cy,
-                                      parents[p].iz * sz + cz});
+                                push({parents[p].ix * s + cx, parents[p].iy * s + cy, parents[p].iz * sz + cz,
+                                      parents[p].variant});
                     row = row_end;
                 }
             }
@@ -203,6 +213,8 @@ private:
         evaluate(m);
 
         const bool last = level_ == r_.options.depth;
+        const int remaining = r_.options.depth - level_;
+        const bool consider_pruning = remaining >= prune_min_remaining && level_ % prune_period == 0;
         LevelCounts& lc = r_.levels[static_cast<std::size_t>(level_)];
         for (std::size_t j = 0; j < m; ++j) {
             CellClass cls = CellClass::boundary;
@@ -220,6 +232,8 @@ private:
                 if (!last) {
                     cls = CellClass::subdivided;
                     next_.push_back(queue_[j]);
+                    if (consider_pruning)
+                        next_.back().variant = pruned_variant(queue_[j].variant, &boxes_[j * d]);
                 }
                 break;
             }
@@ -237,22 +251,94 @@ private:
         }
     }
 
-    // Evaluates boxes_[0, m) into out_: in one call, or in one contiguous chunk per thread.
+    // Evaluates boxes_[0, m) into out_, each cell with its variant's function: the cells are gathered
+    // by variant, each variant's run is cut into at most one chunk per thread (chunk c of a variant
+    // uses that variant's evaluator c), all chunks run in one parallel loop, and the results are put
+    // back in place.
     void evaluate(std::size_t m) {
         const auto d = static_cast<std::size_t>(d_);
-        const auto chunks =
-            std::min<std::size_t>(static_cast<std::size_t>(threads_), (m + min_chunk - 1) / min_chunk);
-        if (chunks <= 1) {
-            f_.eval_boxes(boxes_.data(), m, out_.data());
-            return;
+        bool mixed = false;
+        for (std::size_t j = 0; j < m && !mixed; ++j) mixed = queue_[j].variant != queue_[0].variant;
+        const Interval* boxes = boxes_.data();
+        Interval* out = out_.data();
+        order_.clear();
+        std::vector<std::size_t> starts{0}; // of each variant's run in the gathered order
+        std::vector<std::uint32_t> run_variant;
+        if (!mixed) {
+            run_variant.push_back(queue_[0].variant);
+            starts.push_back(m);
+        } else {
+            std::vector<std::vector<std::size_t>> members(variants_.size());
+            for (std::size_t j = 0; j < m; ++j) members[queue_[j].variant].push_back(j);
+            for (std::uint32_t v = 0; v < members.size(); ++v) {
+                if (members[v].empty()) continue;
+                order_.insert(order_.end(), members[v].begin(), members[v].end());
+                run_variant.push_back(v);
+                starts.push_back(order_.size());
+            }
+            group_boxes_.resize(m * d);
+            group_out_.resize(m);
+            for (std::size_t i = 0; i < m; ++i) std::copy_n(&boxes_[order_[i] * d], d, &group_boxes_[i * d]);
+            boxes = group_boxes_.data();
+            out = group_out_.data();
         }
-        arena_.execute([&] {
-            tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
-                const std::size_t begin = m * c / chunks, end = m * (c + 1) / chunks;
-                ir::Evaluator& e = c == 0 ? f_ : *clones_[c - 1];
-                e.eval_boxes(boxes_.data() + begin * d, end - begin, out_.data() + begin);
+        struct Chunk {
+            std::uint32_t variant, worker;
+            std::size_t begin, end;
+        };
+        std::vector<Chunk> chunks;
+        for (std::size_t r = 0; r < run_variant.size(); ++r) {
+            const std::size_t n = starts[r + 1] - starts[r];
+            if (run_variant[r] != 0) r_.pruned_evaluations += n;
+            const auto k = std::max<std::size_t>(1, std::min<std::size_t>(static_cast<std::size_t>(threads_),
+                                                                          (n + min_chunk - 1) / min_chunk));
+            for (std::size_t c = 0; c < k; ++c)
+                chunks.push_back({run_variant[r], static_cast<std::uint32_t>(c), starts[r] + n * c / k,
+                                  starts[r] + n * (c + 1) / k});
+        }
+        const auto run_chunk = [&](const Chunk& c) {
+            variants_[c.variant].workers[c.worker]->eval_boxes(boxes + c.begin * d, c.end - c.begin,
+                                                               out + c.begin);
+        };
+        if (chunks.size() == 1 || threads_ == 1) {
+            for (const Chunk& c : chunks) run_chunk(c);
+        } else {
+            arena_.execute([&] {
+                tbb::parallel_for(std::size_t{0}, chunks.size(),
+                                  [&](std::size_t i) { run_chunk(chunks[i]); });
             });
-        });
+        }
+        if (mixed)
+            for (std::size_t i = 0; i < m; ++i) out_[order_[i]] = group_out_[i];
+    }
+
+    // Descendant evaluations of an undecided cell `remaining` levels above the depth, if the
+    // boundary through it is a smooth curve or surface: split^d children, then split^(d-1) times
+    // more cells per level.
+    double expected_descendants(int remaining) const {
+        const double s = r_.options.split;
+        double per_level = std::pow(s, d_), total = 0;
+        for (int j = 0; j < remaining; ++j, per_level *= std::pow(s, d_ - 1)) total += per_level;
+        return total;
+    }
+
+    // The variant the children of an undecided cell of variant v with box `box` evaluate: a pruned
+    // function when the evaluator offers one (the same function always maps to the same variant).
+    std::uint32_t pruned_variant(std::uint32_t v, const Interval* box) {
+        ir::Evaluator& e = *variants_[v].workers[0];
+        std::shared_ptr<ir::Evaluator> p = e.specialize(box, expected_descendants(r_.options.depth - level_));
+        if (!p) return v;
+        auto [it, added] = variant_of_.try_emplace(p.get(), static_cast<std::uint32_t>(variants_.size()));
+        if (added) {
+            Variant nv;
+            nv.function = p;
+            for (int t = 0; t < threads_; ++t) {
+                nv.owned.push_back(p->clone());
+                nv.workers.push_back(nv.owned.back().get());
+            }
+            variants_.push_back(std::move(nv));
+        }
+        return it->second;
     }
 
     static constexpr std::size_t min_chunk = 256; // below this a thread costs more than it saves
@@ -262,6 +348,17 @@ private:
     int threads_;
     tbb::task_arena arena_;
     std::vector<std::unique_ptr<ir::Evaluator>> clones_;
+    // The functions cells evaluate: 0 is the shape's (f_ and its clones), the others pruned ones,
+    // each with an evaluator per thread.
+    struct Variant {
+        std::shared_ptr<ir::Evaluator> function;
+        std::vector<std::unique_ptr<ir::Evaluator>> owned;
+        std::vector<ir::Evaluator*> workers; // one per thread
+    };
+    std::vector<Variant> variants_;
+    std::unordered_map<const ir::Evaluator*, std::uint32_t> variant_of_;
+    std::vector<Interval> group_boxes_, group_out_; // cells gathered by variant
+    std::vector<std::size_t> order_;                // ... their positions in the batch
     std::size_t flush_at_ = 0;
     int level_ = 0;
     std::uint64_t n_ = 1;               // cells per axis at level_
@@ -296,6 +393,13 @@ RssResult subdivide(ir::Evaluator& f, const std::vector<Interval>& root, const R
     Runner(f, r).run();
     r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
     return r;
+}
+
+bool same_cover(const RssResult& a, const RssResult& b) {
+    return std::equal(
+        a.cells.begin(), a.cells.end(), b.cells.begin(), b.cells.end(), [](const Cell& x, const Cell& y) {
+            return x.level == y.level && x.cls == y.cls && x.ix == y.ix && x.iy == y.iy && x.iz == y.iz;
+        });
 }
 
 } // namespace frac::rt

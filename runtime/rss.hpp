@@ -58,6 +58,16 @@ struct RssOptions {
     bool closed_inside = false;
 };
 
+// Min/max pruning (ir/specialize.hpp, switched by EvalOptions::prune): an undecided cell far enough
+// above the depth limit asks its evaluator for a simplified function, which its descendants then
+// evaluate. The cover is the same with and without it (docs/design.md, "Pruning").
+// Pruning is considered for undecided cells at levels k with depth - k >= prune_min_remaining and
+// k a multiple of prune_period. Closer to the depth too few descendants are left to repay recording
+// the choices (one interpreter evaluation of the cell); measured on bench/csg_scene.frac with both
+// engines (docs/performance.md).
+inline constexpr int prune_min_remaining = 5;
+inline constexpr int prune_period = 1;
+
 // Hard limits, reported as errors when exceeded. Besides, split^depth must not exceed 2^32 (cell
 // positions are 32-bit): with split 3 the depth is at most 20, with split 4 at most 16.
 inline constexpr int max_depth_2d = 24;
@@ -77,6 +87,9 @@ struct RssResult {
     // Totals over all levels; evaluated = inside + outside + boundary + subdivided.
     std::uint64_t evaluated = 0, inside = 0, outside = 0, boundary = 0, subdivided = 0;
     double seconds = 0; // wall time of subdivide (steady clock)
+    // Pruning: cells evaluated with a simplified function, and how many distinct functions they used.
+    std::uint64_t pruned_evaluations = 0;
+    std::size_t specializations = 0;
 
     // Outward enclosure of a cell's box along `axis`: lo = RD(x0 + (x1-x0)*i/n),
     // hi = RU(x0 + (x1-x0)*(i+1)/n), n = split^level, clamped to the root box. Neighbouring cells
@@ -91,5 +104,9 @@ struct RssResult {
 // Throws std::invalid_argument on a bad depth/split/batch or a box of the wrong dimension (the
 // root must have 2 or 3 axes, as many as f.dimension(), each finite with lo < hi).
 RssResult subdivide(ir::Evaluator& f, const std::vector<Interval>& root, const RssOptions& options);
+
+// Whether two results recorded the same cells (level, class and position, in the same order): the
+// same cover, e.g. with pruning on and off, or with two engines.
+bool same_cover(const RssResult& a, const RssResult& b);
 
 } // namespace frac::rt

@@ -3,6 +3,7 @@
 #include "ir/semantics.hpp"
 #include "ir/series_tail.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -18,8 +19,9 @@ namespace {
 
 class Interpreter final : public ir::Evaluator {
 public:
-    Interpreter(Tape tape, const ir::EvalOptions& options)
-        : tape_(std::move(tape)), options_(options), boxes_(tape_.num_slots), points_(tape_.num_slots) {
+    Interpreter(Tape tape, const ir::EvalOptions& options, std::weak_ptr<ir::SpecializationCache> cache = {})
+        : tape_(std::move(tape)), options_(options), cache_(std::move(cache)), boxes_(tape_.num_slots),
+          points_(tape_.num_slots) {
         if (options_.max_terms < 1 || options_.max_terms > ir::max_terms_limit)
             throw std::invalid_argument("max_terms out of range");
         for (const ir::TapeConst& c : tape_.constants) {
@@ -31,7 +33,35 @@ public:
     int dimension() const override { return tape_.inputs; }
     std::string engine() const override { return "interp"; }
     std::unique_ptr<ir::Evaluator> clone() const override {
-        return std::make_unique<Interpreter>(tape_, options_);
+        return std::make_unique<Interpreter>(tape_, options_, cache_);
+    }
+    std::size_t instruction_count() const override { return tape_.instruction_count(); }
+
+    // The interpreter records choices in its own register file: after eval_box it holds every
+    // block-0 value of the box.
+    std::vector<ir::Choice> record(const Interval* box) {
+        const ir::EvalStats saved = stats;
+        eval_box(box);
+        stats = saved; // a recording is not an evaluation of the shape
+        return ir::record_choices(tape_, boxes_.data());
+    }
+
+    std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
+        auto cache = cache_.lock();
+        if (!cache || !options_.prune || !ir::has_choices(tape_)) return nullptr;
+        const auto t0 = std::chrono::steady_clock::now();
+        const std::vector<ir::Choice> choices = record(box);
+        specialize_stats.record_ms +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        ++specialize_stats.requests;
+        return cache->get(tape_, choices, expected_evaluations, specialize_stats);
+    }
+
+    // The root of an evaluator family owns the cache; its specialisations refer to it weakly (the
+    // cache owns them).
+    void own_cache(std::shared_ptr<ir::SpecializationCache> cache) {
+        cache_ = cache;
+        owned_cache_ = std::move(cache);
     }
 
     double eval_point(const double* coords) override {
@@ -209,6 +239,8 @@ private:
 
     Tape tape_;
     ir::EvalOptions options_;
+    std::weak_ptr<ir::SpecializationCache> cache_;
+    std::shared_ptr<ir::SpecializationCache> owned_cache_;
     std::vector<Interval> boxes_;
     std::vector<double> points_;
 };
@@ -216,7 +248,25 @@ private:
 } // namespace
 
 std::unique_ptr<ir::Evaluator> make_interpreter(ir::Tape tape, const ir::EvalOptions& options) {
-    return std::make_unique<Interpreter>(std::move(tape), options);
+    auto root = std::make_unique<Interpreter>(std::move(tape), options);
+    // The specialisations it compiles refer to the cache weakly (the cache owns them).
+    auto self = std::make_shared<std::weak_ptr<ir::SpecializationCache>>();
+    auto cache = std::make_shared<ir::SpecializationCache>(
+        [options, self](const Tape& t) -> std::unique_ptr<ir::Evaluator> {
+            return std::make_unique<Interpreter>(t, options, *self);
+        },
+        interp_prune_costs);
+    *self = cache;
+    root->own_cache(cache);
+    return root;
+}
+
+ChoiceRecorder::ChoiceRecorder(const ir::Tape& tape, const ir::EvalOptions& options)
+    : interp_(std::make_unique<Interpreter>(tape, options)) {}
+ChoiceRecorder::~ChoiceRecorder() = default;
+
+std::vector<ir::Choice> ChoiceRecorder::record(const Interval* box) {
+    return static_cast<Interpreter&>(*interp_).record(box);
 }
 
 } // namespace frac::interp

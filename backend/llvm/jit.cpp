@@ -5,6 +5,7 @@
 #include "backend/llvm/helpers.hpp"
 #include "backend/llvm/pipeline.hpp"
 #include "backend/llvm/tables.hpp"
+#include "ir/specialize.hpp"
 
 #include <llvm/ExecutionEngine/Orc/CompileUtils.h>
 #include <llvm/ExecutionEngine/Orc/Core.h>
@@ -177,6 +178,8 @@ Generated generate_module(const ir::Tape& tape, const ir::EvalOptions& options, 
 struct Compiled {
     ir::Tape tape;
     ir::EvalOptions options;
+    JitConfig config;
+    bool has_choices = false; // block 0 has min/max/select instructions to prune
     BatchBoxes boxes = nullptr;
     BatchPoints points = nullptr;
     llvm::orc::ResourceTrackerSP tracker;
@@ -192,11 +195,34 @@ struct Compiled {
 
 class JitEvaluator final : public ir::Evaluator {
 public:
-    explicit JitEvaluator(std::shared_ptr<const Compiled> code) : code_(std::move(code)) {}
+    explicit JitEvaluator(std::shared_ptr<const Compiled> code,
+                          std::weak_ptr<ir::SpecializationCache> cache = {})
+        : code_(std::move(code)), cache_(std::move(cache)) {}
 
     int dimension() const override { return code_->tape.inputs; }
     std::string engine() const override { return "jit"; }
-    std::unique_ptr<ir::Evaluator> clone() const override { return std::make_unique<JitEvaluator>(code_); }
+    std::unique_ptr<ir::Evaluator> clone() const override {
+        return std::make_unique<JitEvaluator>(code_, cache_);
+    }
+    std::size_t instruction_count() const override { return code_->tape.instruction_count(); }
+
+    // Choices are recorded with the interpreter (the generated code keeps no register file); the
+    // interpreter's enclosures are the JIT's bit for bit, so both engines prune alike.
+    std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
+        auto cache = cache_.lock();
+        if (!cache || !code_->options.prune || !code_->has_choices) return nullptr;
+        const auto t0 = Clock::now();
+        if (!recorder_) recorder_ = std::make_unique<interp::ChoiceRecorder>(code_->tape, code_->options);
+        const std::vector<ir::Choice> choices = recorder_->record(box);
+        specialize_stats.record_ms += ms_since(t0);
+        ++specialize_stats.requests;
+        return cache->get(code_->tape, choices, expected_evaluations, specialize_stats);
+    }
+
+    void own_cache(std::shared_ptr<ir::SpecializationCache> cache) {
+        cache_ = cache;
+        owned_cache_ = std::move(cache);
+    }
 
     double eval_point(const double* coords) override {
         double r;
@@ -256,6 +282,9 @@ private:
 
     std::shared_ptr<const Compiled> code_;
     std::unique_ptr<ir::Evaluator> interp_;
+    std::weak_ptr<ir::SpecializationCache> cache_;
+    std::shared_ptr<ir::SpecializationCache> owned_cache_; // the root of a family owns the cache
+    std::unique_ptr<interp::ChoiceRecorder> recorder_;
 };
 
 } // namespace
@@ -267,7 +296,10 @@ bool host_has_avx512() {
     return e && e->avx512;
 }
 
-std::unique_ptr<ir::Evaluator> make_jit(const ir::Tape& tape, const ir::EvalOptions& options, const JitConfig& config) {
+namespace {
+
+std::shared_ptr<const Compiled> compile(const ir::Tape& tape, const ir::EvalOptions& options,
+                                        const JitConfig& config) {
     const auto t0 = Clock::now();
     check_options(tape, options);
     std::string why;
@@ -279,6 +311,8 @@ std::unique_ptr<ir::Evaluator> make_jit(const ir::Tape& tape, const ir::EvalOpti
     auto code = std::make_shared<Compiled>();
     code->tape = tape;
     code->options = options;
+    code->config = config;
+    code->has_choices = ir::has_choices(tape);
     CompileInfo& info = code->info;
     info.rounding = rounding == Rounding::avx512 ? "avx512" : "constrained";
     info.lanes = lanes;
@@ -311,7 +345,28 @@ std::unique_ptr<ir::Evaluator> make_jit(const ir::Tape& tape, const ir::EvalOpti
     code->points = point->toPtr<BatchPoints>();
     info.machine_ms = ms_since(t);
     info.total_ms = ms_since(t0);
-    return std::make_unique<JitEvaluator>(std::move(code));
+    return code;
+}
+
+} // namespace
+
+std::unique_ptr<ir::Evaluator> make_jit(const ir::Tape& tape, const ir::EvalOptions& options,
+                                        const JitConfig& config) {
+    auto root = std::make_unique<JitEvaluator>(compile(tape, options, config));
+    // Specialisations are compiled like the shape; they refer to the cache weakly (it owns them).
+    auto self = std::make_shared<std::weak_ptr<ir::SpecializationCache>>();
+    auto cache = std::make_shared<ir::SpecializationCache>(
+        [options, config, self](const ir::Tape& t) -> std::unique_ptr<ir::Evaluator> {
+            return std::make_unique<JitEvaluator>(compile(t, options, config), *self);
+        },
+        jit_prune_costs,
+        // Until a pruned tape has earned its compile time, the interpreter runs it when that is faster
+        // than the JIT running the whole tape; its enclosures are the JIT's bit for bit.
+        [options](const ir::Tape& t) { return interp::make_interpreter(t, options); },
+        interp::interp_prune_costs.eval_ns_per_cost);
+    *self = cache;
+    root->own_cache(std::move(cache));
+    return root;
 }
 
 const CompileInfo* compile_info(const ir::Evaluator& e) {

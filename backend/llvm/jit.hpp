@@ -12,6 +12,7 @@
 #pragma once
 
 #include "ir/evaluator.hpp"
+#include "ir/specialize.hpp"
 #include "ir/tape.hpp"
 
 #include <memory>
@@ -49,6 +50,11 @@ bool host_has_avx512();
 // does). The evaluator and its clones share the machine code.
 std::unique_ptr<ir::Evaluator> make_jit(const ir::Tape& tape, const ir::EvalOptions& options = {},
                                         const JitConfig& config = {});
+
+// What specialising costs and saves with the JIT (ir/specialize.hpp), measured by bench/bench_prune:
+// evaluation time per unit of tape cost and box, compile time of a pruned tape.
+inline constexpr ir::PruneCosts jit_prune_costs{/*eval_ns_per_cost=*/0.8, /*compile_ns_fixed=*/2.0e7,
+                                                /*compile_ns_per_instruction=*/2.0e6};
 
 // What compiling one tape cost (wall clock, milliseconds), for benchmarks and --verbose output.
 struct CompileInfo {

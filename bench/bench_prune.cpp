@@ -1,0 +1,325 @@
+// Min/max pruning per region and adaptive series truncation, every variant measured in this one run:
+//  1. the constants of the pruning rule (ir/specialize.hpp): evaluation time per unit of tape cost,
+//     and the JIT's compile time of pruned tapes against their size (least squares);
+//  2. RSS covers of CSG shapes with pruning off and on, with both engines: time, cells evaluated
+//     with a pruned function, cache hits, compiles and the time they took, and whether the covers
+//     are identical (they must be);
+//  3. adaptive series truncation on and off with both engines.
+// Prints tables of ratios and writes JSON.
+//
+//   bench_prune [depth=10] [json=bench_prune.json] [depth_3d=7]
+#include "backend/interp/interpreter.hpp"
+#include "backend/llvm/jit.hpp"
+#include "frontend/driver.hpp"
+#include "ir/specialize.hpp"
+#include "ir/tape.hpp"
+#include "runtime/rss.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <fmt/format.h>
+#include <fstream>
+#include <iostream>
+#include <random>
+#include <set>
+
+using namespace frac;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+struct Shape {
+    std::string name;
+    int dimension;
+    std::vector<ir::Interval> box;
+    ir::Tape tape;
+};
+
+// The named shape of a model file (relative to the source tree) or of a stdlib module.
+Shape load(const std::string& source, const std::string& name, bool is_file) {
+    auto c = is_file ? front::compile_file(std::string(FRAC_SOURCE_DIR) + "/" + source)
+                     : front::compile_source("bench.frac", "import \"" + source + "\";");
+    if (!c->ok()) {
+        std::cerr << c->diags.render(c->sources);
+        std::exit(1);
+    }
+    for (const front::ShapeInfo& s : c->module.shapes)
+        if (s.name == name)
+            return {s.name, s.dimension, s.box, ir::build_tape(c->module.graph, s.root, s.dimension)};
+    std::cerr << "bench_prune: no shape " << name << " in " << source << "\n";
+    std::exit(1);
+}
+
+using Make = std::unique_ptr<ir::Evaluator> (*)(const ir::Tape&, const ir::EvalOptions&);
+std::unique_ptr<ir::Evaluator> make_interp(const ir::Tape& t, const ir::EvalOptions& o) {
+    return interp::make_interpreter(t, o);
+}
+std::unique_ptr<ir::Evaluator> make_jit(const ir::Tape& t, const ir::EvalOptions& o) {
+    return jit::make_jit(t, o);
+}
+
+struct Run {
+    rt::RssResult result;
+    ir::EvalStats stats;
+    ir::SpecializeStats spec;
+    double seconds = 1e300; // best of the repetitions (each with a fresh evaluator: compiles count)
+    double compile_s = 0;   // compiling the shape itself (JIT), not counted in `seconds`
+};
+
+void cover_once(Make make, const Shape& s, int depth, const ir::EvalOptions& o, Run& run) {
+    const auto t0 = Clock::now();
+    auto e = make(s.tape, o);
+    run.compile_s = seconds_since(t0);
+    rt::RssOptions ro;
+    ro.depth = depth;
+    rt::RssResult res = rt::subdivide(*e, s.box, ro);
+    if (res.seconds < run.seconds) {
+        run.seconds = res.seconds;
+        run.stats = e->stats;
+        run.spec = e->specialize_stats;
+        run.result = std::move(res);
+    }
+}
+
+// Two variants, repetitions interleaved (the machine is shared: a disturbance then hits both alike
+// instead of one of them); the best of each.
+std::pair<Run, Run> cover_pair(Make make, const Shape& s, int depth, const ir::EvalOptions& a,
+                               const ir::EvalOptions& b, int reps) {
+    std::pair<Run, Run> runs;
+    Run warm_up; // the first cover of a process pays for growing the heap
+    cover_once(make, s, std::max(0, depth - 2), a, warm_up);
+    for (int r = 0; r < reps; ++r) {
+        // Alternate which goes first, so that neither always follows the other.
+        if (r % 2 == 0) cover_once(make, s, depth, a, runs.first);
+        cover_once(make, s, depth, b, runs.second);
+        if (r % 2 == 1) cover_once(make, s, depth, a, runs.first);
+    }
+    return runs;
+}
+
+// Boxes of the cells of a cover (every level), for timing evaluations.
+std::vector<ir::Interval> cell_boxes(const rt::RssResult& r) {
+    std::vector<ir::Interval> boxes;
+    for (const rt::Cell& c : r.cells)
+        for (int a = 0; a < r.dimension(); ++a) boxes.push_back(r.cell_interval(c, a));
+    return boxes;
+}
+
+// Nanoseconds per box to evaluate `boxes` (batches of 4096), best of `reps`.
+double ns_per_box(ir::Evaluator& e, const std::vector<ir::Interval>& boxes, int reps) {
+    const auto d = static_cast<std::size_t>(e.dimension());
+    const std::size_t n = boxes.size() / d;
+    std::vector<ir::Interval> out(n);
+    double best = 1e300;
+    for (int r = 0; r < reps; ++r) {
+        const auto t0 = Clock::now();
+        for (std::size_t i = 0; i < n; i += 4096)
+            e.eval_boxes(boxes.data() + d * i, std::min<std::size_t>(4096, n - i), out.data() + i);
+        best = std::min(best, seconds_since(t0));
+    }
+    return 1e9 * best / double(n);
+}
+
+// Least squares y = a + b x.
+std::pair<double, double> fit(const std::vector<double>& x, const std::vector<double>& y) {
+    const double n = double(x.size());
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        sx += x[i];
+        sy += y[i];
+        sxx += x[i] * x[i];
+        sxy += x[i] * y[i];
+    }
+    const double b = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+    return {(sy - b * sx) / n, b};
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    const int depth = argc > 1 ? std::atoi(argv[1]) : 10;
+    const std::string json_path = argc > 2 ? argv[2] : "bench_prune.json";
+    const int depth_3d = argc > 3 ? std::atoi(argv[3]) : 7;
+    std::string why;
+    if (!jit::jit_available(&why)) {
+        std::cerr << "bench_prune: the JIT is not available: " << why << "\n";
+        return 1;
+    }
+    std::vector<Shape> shapes = {
+        load("bench/csg_scene.frac", "csg_scene", true), load("koch", "double_koch", false),
+        load("examples/menger_frame.frac", "sponge_in_frame", true),
+        load("fractals", "carpet", false), // no min/max outside its series: nothing to prune
+    };
+    const Shape& scene = shapes[0];
+    std::string json = "{\n";
+
+    // ---- 1. The rule's constants ----
+    // Pruned tapes of the scene: choices recorded over random sub-boxes of its cover's cells.
+    std::vector<ir::Tape> pruned;
+    std::vector<ir::Interval> scene_boxes;
+    {
+        auto e = interp::make_interpreter(scene.tape);
+        rt::RssOptions ro;
+        ro.depth = 6;
+        const rt::RssResult r = rt::subdivide(*e, scene.box, ro);
+        scene_boxes = cell_boxes(r);
+        interp::ChoiceRecorder rec(scene.tape, {});
+        std::set<std::string> seen;
+        for (std::size_t i = 0; i + 1 < scene_boxes.size() && pruned.size() < 24; i += 2 * 37) {
+            const auto choices = rec.record(&scene_boxes[i]);
+            if (!ir::any_decided(choices)) continue;
+            ir::Tape t = ir::specialize(scene.tape, choices);
+            if (seen.insert(ir::tape_key(t)).second) pruned.push_back(std::move(t));
+        }
+    }
+    // Compile time of the JIT against the pruned tape's size (best of 3 per tape).
+    std::vector<double> sizes, compile_ms, costs, jit_ns, interp_ns;
+    for (const ir::Tape& t : pruned) {
+        double best = 1e300;
+        for (int r = 0; r < 3; ++r) best = std::min(best, jit::compile_info(*jit::make_jit(t))->total_ms);
+        sizes.push_back(double(t.instruction_count()));
+        compile_ms.push_back(best);
+    }
+    const auto [compile_fixed, compile_per_instr] = fit(sizes, compile_ms);
+    // The interpreter's "compile" of the same tapes: a copy and a register file.
+    double interp_make_us = 0;
+    for (const ir::Tape& t : pruned) {
+        double best = 1e300;
+        for (int r = 0; r < 3; ++r) {
+            const auto t0 = Clock::now();
+            auto e = interp::make_interpreter(t);
+            best = std::min(best, 1e6 * seconds_since(t0));
+        }
+        interp_make_us += best / double(pruned.size());
+    }
+    // Evaluation time per unit of tape cost: the full and the pruned tapes over the same boxes.
+    std::vector<ir::Tape> timed = pruned;
+    timed.push_back(scene.tape);
+    for (const ir::Tape& t : timed) {
+        costs.push_back(ir::tape_cost(t));
+        jit_ns.push_back(ns_per_box(*jit::make_jit(t), scene_boxes, 3));
+        interp_ns.push_back(ns_per_box(*interp::make_interpreter(t), scene_boxes, 1));
+    }
+    const auto [jit_ns0, jit_ns_per_cost] = fit(costs, jit_ns);
+    const auto [interp_ns0, interp_ns_per_cost] = fit(costs, interp_ns);
+    fmt::print(
+        "Pruning rule constants ({} pruned tapes of csg_scene, {} instructions unpruned, cost {:.0f})\n",
+        pruned.size(), scene.tape.instruction_count(), ir::tape_cost(scene.tape));
+    fmt::print(
+        "  JIT compile:      {:.2f} ms + {:.4f} ms per instruction   (in use: {:.2f} ms + {:.4f} ms)\n",
+        compile_fixed, compile_per_instr, jit::jit_prune_costs.compile_ns_fixed * 1e-6,
+        jit::jit_prune_costs.compile_ns_per_instruction * 1e-6);
+    fmt::print("  interpreter make: {:.1f} us on average   (in use: {:.1f} us)\n", interp_make_us,
+               interp::interp_prune_costs.compile_ns_fixed * 1e-3);
+    fmt::print("  JIT eval:         {:.1f} ns + {:.3f} ns per cost unit, per box   (in use: {:.3f})\n",
+               jit_ns0, jit_ns_per_cost, jit::jit_prune_costs.eval_ns_per_cost);
+    fmt::print("  interpreter eval: {:.1f} ns + {:.3f} ns per cost unit, per box   (in use: {:.3f})\n",
+               interp_ns0, interp_ns_per_cost, interp::interp_prune_costs.eval_ns_per_cost);
+    fmt::print("  {:>8} {:>8} {:>11} {:>10} {:>12}\n", "instrs", "cost", "compile ms", "jit ns/box",
+               "interp ns/box");
+    for (std::size_t i = 0; i < timed.size(); ++i)
+        fmt::print("  {:>8} {:>8.0f} {:>11} {:>10.1f} {:>12.1f}{}\n", timed[i].instruction_count(), costs[i],
+                   i < compile_ms.size() ? fmt::format("{:.2f}", compile_ms[i]) : "-", jit_ns[i],
+                   interp_ns[i], i + 1 == timed.size() ? "  (unpruned)" : "");
+    json += fmt::format("  \"rule\": {{\"pruned_tapes\": {}, \"jit_compile_ms_fixed\": {:.4f}, "
+                        "\"jit_compile_ms_per_instruction\": {:.6f}, \"interp_make_us\": {:.3f}, "
+                        "\"jit_eval_ns_fixed\": {:.3f}, "
+                        "\"jit_eval_ns_per_cost\": {:.5f}, \"interp_eval_ns_fixed\": {:.3f}, "
+                        "\"interp_eval_ns_per_cost\": {:.5f}}},\n",
+                        pruned.size(), compile_fixed, compile_per_instr, interp_make_us, jit_ns0,
+                        jit_ns_per_cost, interp_ns0, interp_ns_per_cost);
+
+    // ---- 2. Covers with pruning off and on ----
+    fmt::print(
+        "\nRSS covers with pruning off and on (one thread; best of runs, each with a fresh evaluator)\n");
+    fmt::print("{:<16} {:<6} {:>5} {:>9} {:>8} {:>8} {:>7} {:>8} {:>6} {:>5} {:>5} {:>5} {:>8} {:>8} {:>5}\n",
+               "shape", "engine", "depth", "boxes", "off s", "on s", "off/on", "pruned%", "funcs", "hits",
+               "comp", "tier2", "comp ms", "rec ms", "same");
+    json += "  \"covers\": [\n";
+    bool first_row = true;
+    // Every shape with both engines, and the scene two levels deeper with the JIT, whose compiles
+    // pay only for many boxes.
+    struct Job {
+        const Shape* shape;
+        const char* name;
+        Make make;
+        int depth;
+    };
+    std::vector<Job> jobs;
+    for (const Shape& s : shapes)
+        for (auto [name, make] : {std::pair<const char*, Make>{"jit", make_jit}, {"interp", make_interp}})
+            jobs.push_back({&s, name, make, s.dimension == 2 ? depth : depth_3d});
+    jobs.insert(jobs.begin() + 2, Job{&scene, "jit", make_jit, depth + 2});
+    for (const Job& job : jobs) {
+        const Shape& s = *job.shape;
+        const int d = job.depth;
+        const char* name = job.name;
+        const Make make = job.make;
+        {
+            ir::EvalOptions off, on;
+            off.prune = false;
+            const int reps = std::string(name) == "jit" ? 3 : 2;
+            const auto [a, b] = cover_pair(make, s, d, off, on, reps);
+            const bool same = rt::same_cover(a.result, b.result);
+            const double pruned_share =
+                100.0 * double(b.result.pruned_evaluations) / double(b.result.evaluated);
+            fmt::print("{:<16} {:<6} {:>5} {:>9} {:>8.3f} {:>8.3f} {:>6.2f}x {:>7.1f}% {:>6} {:>5} {:>5} "
+                       "{:>5} {:>8.1f} "
+                       "{:>8.1f} {:>5}\n",
+                       s.name, name, d, b.result.evaluated, a.seconds, b.seconds, a.seconds / b.seconds,
+                       pruned_share, b.result.specializations, b.spec.hits, b.spec.compiled, b.spec.fallbacks,
+                       b.spec.compile_ms, b.spec.record_ms, same ? "yes" : "DIFFERS");
+            json += fmt::format(
+                "{}    {{\"shape\": \"{}\", \"engine\": \"{}\", \"depth\": {}, \"boxes\": {}, "
+                "\"off_seconds\": {:.6f}, \"on_seconds\": {:.6f}, \"speedup\": {:.4f}, "
+                "\"pruned_evaluations\": {}, \"functions\": {}, \"requests\": {}, \"unpruned\": {}, "
+                "\"too_little\": {}, \"declined\": {}, \"hits\": {}, \"compiled\": {}, \"fallbacks\": {}, "
+                "\"compile_ms\": {:.3f}, \"record_ms\": {:.3f}, \"series_terms_off\": {}, "
+                "\"series_terms_on\": {}, \"same_cover\": {}}}",
+                first_row ? "" : ",\n", s.name, name, d, b.result.evaluated, a.seconds, b.seconds,
+                a.seconds / b.seconds, b.result.pruned_evaluations, b.result.specializations, b.spec.requests,
+                b.spec.unpruned, b.spec.too_little, b.spec.declined, b.spec.hits, b.spec.compiled,
+                b.spec.fallbacks, b.spec.compile_ms, b.spec.record_ms, a.stats.series_terms,
+                b.stats.series_terms, same ? "true" : "false");
+            first_row = false;
+        }
+    }
+    json += "\n  ],\n";
+
+    // ---- 3. Adaptive series truncation ----
+    fmt::print("\nAdaptive series truncation off and on (pruning off; one thread)\n");
+    fmt::print("{:<16} {:<6} {:>5} {:>10} {:>10} {:>9} {:>9} {:>10} {:>10} {:>12}\n", "shape", "engine",
+               "depth", "fixed s", "adapt s", "fixed/ad", "terms/box", "terms/box", "boundary", "boundary");
+    fmt::print("{:<16} {:<6} {:>5} {:>10} {:>10} {:>9} {:>9} {:>10} {:>10} {:>12}\n", "", "", "", "", "", "",
+               "fixed", "adaptive", "fixed", "adaptive");
+    json += "  \"adaptive_terms\": [\n";
+    first_row = true;
+    for (const Shape* s : {&shapes[3], &shapes[0]}) {
+        for (auto [name, make] : {std::pair<const char*, Make>{"jit", make_jit}, {"interp", make_interp}}) {
+            ir::EvalOptions fixed, adaptive;
+            fixed.adaptive_terms = adaptive.prune = fixed.prune = false;
+            const int reps = std::string(name) == "jit" ? 3 : 1;
+            const auto [f, a] = cover_pair(make, *s, depth, fixed, adaptive, reps);
+            const double tf = double(f.stats.series_terms) / double(f.result.evaluated);
+            const double ta = double(a.stats.series_terms) / double(a.result.evaluated);
+            fmt::print("{:<16} {:<6} {:>5} {:>10.3f} {:>10.3f} {:>8.2f}x {:>9.2f} {:>10.2f} {:>10} {:>12}\n",
+                       s->name, name, depth, f.seconds, a.seconds, f.seconds / a.seconds, tf, ta,
+                       f.result.boundary, a.result.boundary);
+            json += fmt::format(
+                "{}    {{\"shape\": \"{}\", \"engine\": \"{}\", \"depth\": {}, \"fixed_seconds\": {:.6f}, "
+                "\"adaptive_seconds\": {:.6f}, \"speedup\": {:.4f}, \"terms_per_box_fixed\": {:.3f}, "
+                "\"terms_per_box_adaptive\": {:.3f}, \"boundary_fixed\": {}, \"boundary_adaptive\": {}}}",
+                first_row ? "" : ",\n", s->name, name, depth, f.seconds, a.seconds, f.seconds / a.seconds, tf,
+                ta, f.result.boundary, a.result.boundary);
+            first_row = false;
+        }
+    }
+    json += "\n  ]\n}\n";
+    std::ofstream(json_path) << json;
+    fmt::print("wrote {}\n", json_path);
+    return 0;
+}

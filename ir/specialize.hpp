@@ -1,0 +1,117 @@
+// Min/max pruning per region (libfive's tape push, Fidget's simplify-and-recompile): when an interval
+// evaluation over a box proves that a min, max, and, or picks one operand everywhere in the box (their
+// enclosures do not overlap), or that the condition of a select is decided, the sub-boxes evaluate a
+// tape where that instruction is replaced by the operand it picks, and the code only the other
+// operand needed is gone.
+//
+// Soundness and identity (docs/design.md, "Pruning"):
+//  - Only instructions of block 0 (run once per evaluation) are pruned; a choice inside a series block
+//    would have to hold for terms the parent box never evaluated.
+//  - A choice is taken only when the dropped operand (the select's condition) cannot become empty on
+//    a sub-box: every partial operation (sqrt, log, div, pow) it depends on had its argument inside
+//    the domain over the whole box. An empty operand would make min/max empty, and the pruned tape
+//    would not.
+//  - Given inclusion isotone enclosures (a sub-box's enclosure lies in the box's), the pruned tape
+//    computes bit for bit what the full tape computes on every sub-box; without it (a series whose
+//    adaptive term count changes), it is still a guaranteed enclosure of the same function.
+#pragma once
+
+#include "ir/evaluator.hpp"
+#include "ir/tape.hpp"
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace frac::ir {
+
+// Which operand a choice instruction takes over a box. For min/max/and/or: first = in[0],
+// second = in[1]; for select: first = the then-value (in[1]), second = the else-value (in[2]).
+enum class Choice : std::uint8_t { both, first, second };
+
+// Min, Max, And, Or, Select.
+bool is_choice(Op op);
+// Whether block 0 of the tape has a choice instruction (else nothing can ever be pruned).
+bool has_choices(const Tape& tape);
+
+// The choices of the block-0 instructions (one entry per instruction of tape.blocks[0], `both` for
+// any other) after an interval evaluation of `tape` over a box; `slots` is the evaluator's register
+// file (indexed by slot) after that evaluation, so it holds every block-0 value for the box.
+std::vector<Choice> record_choices(const Tape& tape, const Interval* slots);
+
+// Whether any entry is decided.
+bool any_decided(const std::vector<Choice>& choices);
+
+// The tape with each decided choice of block 0 replaced by the operand it takes, the code no longer
+// needed removed (series included) and the slots renumbered densely in program order, so two ways
+// of pruning to the same function give the same tape. Throws std::invalid_argument on a choices
+// vector of the wrong size.
+Tape specialize(const Tape& tape, const std::vector<Choice>& choices);
+
+// A byte string identifying a tape exactly (the cache key of compiled specialisations).
+std::string tape_key(const Tape& tape);
+
+// Relative cost of one box evaluation: block-0 instructions count once, the instructions of a series
+// block `series_terms_estimate` times (per level of nesting).
+inline constexpr double series_terms_estimate = 8;
+double tape_cost(const Tape& tape);
+
+// What an engine's specialisation costs and saves, measured by bench/bench_prune.cpp (the constants
+// are in each engine; docs/performance.md has the measurements).
+struct PruneCosts {
+    double eval_ns_per_cost = 1;           // evaluation time per unit of tape_cost, per box
+    double compile_ns_fixed = 0;           // compiling a specialised tape: fixed part ...
+    double compile_ns_per_instruction = 0; // ... and per instruction of the pruned tape
+};
+
+// The rule (docs/design.md). A pruned tape is used when
+//   cost(pruned) <= max_cost_ratio * cost(current),
+// and it is compiled once the evaluations asked for it (the sum of expected_evaluations over every
+// request for that same tape, compiled or not: the cache remembers the demand) would save more
+// than compiling it costs:
+//   demand * eval_ns_per_cost * (cost(current) - cost(pruned)) >= compile_ns_fixed
+//                                             + compile_ns_per_instruction * instructions(pruned).
+// Until then an engine with a cheaper second tier (the JIT: the interpreter, no compile time) uses
+// it when that evaluates the pruned tape faster than the engine evaluates the current one:
+//   fallback_ns_per_cost * cost(pruned) < eval_ns_per_cost * cost(current).
+inline constexpr double max_cost_ratio = 0.9;
+// Compiled specialisations one evaluator family keeps; past it, new ones are declined.
+inline constexpr std::size_t max_specializations = 512;
+
+// The specialisations of one evaluator family (an evaluator, its clones and its specialisations):
+// compiled once per distinct pruned tape, shared by all. Thread-safe.
+class SpecializationCache {
+public:
+    using Compile = std::function<std::unique_ptr<Evaluator>(const Tape&)>;
+    // `fallback` (optional) makes the second tier's evaluator of a tape, whose results are the
+    // engine's bit for bit; `fallback_ns_per_cost` is its evaluation time per unit of tape cost.
+    SpecializationCache(Compile compile, PruneCosts costs, Compile fallback = {},
+                        double fallback_ns_per_cost = 0)
+        : compile_(std::move(compile)), fallback_(std::move(fallback)), costs_(costs),
+          fallback_ns_per_cost_(fallback_ns_per_cost) {}
+
+    // Applies the rule to the choices recorded on `current`'s box; returns the specialised evaluator
+    // (shared: clone it for another thread) or null. Counts what happened in `stats`.
+    std::shared_ptr<Evaluator> get(const Tape& current, const std::vector<Choice>& choices,
+                                   double expected_evaluations, SpecializeStats& stats);
+
+    const PruneCosts& costs() const { return costs_; }
+    std::size_t size() const;
+
+private:
+    struct Entry {
+        std::shared_ptr<Evaluator> compiled, fallback;
+        double demand = 0; // expected evaluations asked for so far
+    };
+    Compile compile_, fallback_;
+    PruneCosts costs_;
+    double fallback_ns_per_cost_;
+    mutable std::mutex mu_; // held while compiling, so no tape is compiled twice
+    std::map<std::string, Entry> entries_;
+    std::size_t compiled_count_ = 0;
+};
+
+} // namespace frac::ir

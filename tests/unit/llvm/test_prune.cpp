@@ -1,0 +1,309 @@
+// Min/max pruning per region (ir/specialize.hpp) with both engines: pruned tapes are well formed and
+// smaller, give the unpruned enclosure bit for bit on sub-boxes of the box they were recorded on,
+// are the same for both engines, are compiled once (cache), and leave every RSS cover unchanged.
+#include "engines.hpp"
+
+#include "backend/interp/interpreter.hpp"
+#include "ir/specialize.hpp"
+#include "runtime/rss.hpp"
+
+#include <fstream>
+#include <set>
+#include <sstream>
+
+using namespace frac;
+using namespace frac::test;
+
+namespace {
+
+// A CSG composition: two fractals and classical parts under min/max, and a select.
+const char* csg_model = R"(
+import "fractals";
+fn placed_carpet(x, y, x0, y0, s) = max(carpet((x - x0) / s, (y - y0) / s) * s, rect((x, y), (x0, y0), (x0 + s, y0 + s)));
+shape scene(x, y) over [0, 2] × [0, 1] =
+    min(placed_carpet(x, y, 0.1, 0.1, 0.8), max(triangle(x - 1.1, y - 0.1), rect((x, y), (1.1, 0.1), (1.9, 0.9))),
+        disk((x, y), (1.0, 0.5), 0.05));
+shape chooser(x, y) over [-1, 1] × [-1, 1] = if x < 0 then carpet(x + 1, y) else disk((x, y), (0.5, 0), 0.3);
+shape partial(x, y) over [0, 1] × [-1, 1] = min(x - 10, sqrt(y));
+shape quadrant(x, y) over [-1, 1] × [-1, 1] = if x < 0 and y < 0 then carpet(x + 1, y + 1) else disk((x, y), (0.5, 0), 0.3);
+)";
+
+std::string read_file(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+const ir::Tape& tape_of(const Model& m, const std::string& name) {
+    for (std::size_t i = 0; i < m.tapes.size(); ++i)
+        if (m.shape(i).name == name) return m.tapes[i];
+    FAIL("no shape " << name);
+    throw std::logic_error("unreachable");
+}
+const front::ShapeInfo& info_of(const Model& m, const std::string& name) {
+    for (std::size_t i = 0; i < m.tapes.size(); ++i)
+        if (m.shape(i).name == name) return m.shape(i);
+    FAIL("no shape " << name);
+    throw std::logic_error("unreachable");
+}
+
+// A random sub-box of `box`.
+std::vector<Interval> sub_box(BoxMaker& r, const std::vector<Interval>& box) {
+    std::vector<Interval> s;
+    for (const Interval& x : box) {
+        double a = r.uniform(x.lo, x.hi), b = r.uniform(x.lo, x.hi);
+        if (a > b) std::swap(a, b);
+        if (r.pick(4) == 0) b = a; // thin
+        s.push_back({a, b});
+    }
+    return s;
+}
+
+// Boxes of a few cells of every level of a cover (cells where the tape has choices to make).
+std::vector<std::vector<Interval>> cover_boxes(ir::Evaluator& e, const std::vector<Interval>& root, int depth,
+                                               std::size_t stride) {
+    rt::RssOptions o;
+    o.depth = depth;
+    const rt::RssResult r = rt::subdivide(e, root, o);
+    std::vector<std::vector<Interval>> boxes;
+    for (std::size_t k = 0; k < r.cells.size(); k += stride) {
+        std::vector<Interval> b;
+        for (int a = 0; a < r.dimension(); ++a) b.push_back(r.cell_interval(r.cells[k], a));
+        boxes.push_back(b);
+    }
+    return boxes;
+}
+
+} // namespace
+
+TEST_CASE("pruned tapes are well formed, smaller, and exact on sub-boxes", "[llvm][prune]") {
+    const Model m = compile(csg_model);
+    const ir::Tape& tape = tape_of(m, "scene");
+    auto in = InterpEngine::make(tape);
+    auto jt = JitEngine::make(tape);
+    interp::ChoiceRecorder rec(tape, {});
+    BoxMaker r(2024);
+    std::size_t pruned_boxes = 0, compared = 0;
+    for (const auto& box : cover_boxes(*in, info_of(m, "scene").box, 5, 7)) {
+        const std::vector<ir::Choice> choices = rec.record(box.data());
+        REQUIRE(choices.size() == tape.blocks[0].size());
+        if (!ir::any_decided(choices)) continue;
+        ++pruned_boxes;
+        const ir::Tape p = ir::specialize(tape, choices);
+        INFO("box " << hex_box(box.data(), 2));
+        REQUIRE(ir::verify_tape(p).empty());
+        CHECK(p.instruction_count() < tape.instruction_count());
+        // Specialising twice the same way gives the same tape (the cache key is canonical).
+        CHECK(ir::tape_key(p) == ir::tape_key(ir::specialize(tape, choices)));
+        auto pi = InterpEngine::make(p);
+        auto pj = JitEngine::make(p);
+        for (int k = 0; k < 8; ++k) {
+            const std::vector<Interval> s = k == 0 ? box : sub_box(r, box);
+            const Interval full = in->eval_box(s.data());
+            const Interval pruned_i = pi->eval_box(s.data());
+            const Interval pruned_j = pj->eval_box(s.data());
+            INFO("sub-box " << hex_box(s.data(), 2) << ": full " << hex(full) << ", pruned "
+                            << hex(pruned_i));
+            CHECK(same(full, pruned_i));     // isotone enclosures: the dropped operands never matter
+            CHECK(same(pruned_i, pruned_j)); // both engines run the pruned tape alike
+            CHECK(same(full, jt->eval_box(s.data())));
+            ++compared;
+        }
+    }
+    CHECK(pruned_boxes >= 10);
+    CHECK(compared >= 80);
+}
+
+TEST_CASE("both engines specialise alike and compile each pruned tape once", "[llvm][prune]") {
+    const Model m = compile(csg_model);
+    const ir::Tape& tape = tape_of(m, "scene");
+    auto in = InterpEngine::make(tape);
+    auto jt = JitEngine::make(tape);
+    // A box where only the disk and the triangle's square matter, and a sub-box of it.
+    const std::vector<Interval> box{{0.95, 1.05}, {0.45, 0.55}};
+    const std::vector<Interval> inner{{0.97, 1.0}, {0.5, 0.52}};
+    // The JIT compiles when the expected evaluations repay it; asked for few, it declines (or
+    // hands the pruned tape to the interpreter), asked for many it compiles.
+    auto sj = jt->specialize(box.data(), 1e12);
+    auto si = in->specialize(box.data(), 1e12);
+    REQUIRE(sj);
+    REQUIRE(si);
+    CHECK(sj->engine() == "jit");
+    CHECK(sj->instruction_count() == si->instruction_count());
+    CHECK(sj->instruction_count() < tape.instruction_count());
+    CHECK(jt->specialize_stats.compiled == 1);
+    CHECK(in->specialize_stats.compiled == 1);
+    // Asked again, from a clone: the same evaluator, from the cache.
+    auto clone = jt->clone();
+    auto again = clone->specialize(box.data(), 1e12);
+    CHECK(again == sj);
+    CHECK(clone->specialize_stats.hits == 1);
+    CHECK(clone->specialize_stats.compiled == 0);
+    CHECK(in->specialize(box.data(), 1) == si); // compiled already: used whatever the demand
+    // The specialisation is exact on sub-boxes, with both engines.
+    for (const auto& b : {box, inner}) {
+        const Interval full = in->eval_box(b.data());
+        CHECK(same(full, sj->clone()->eval_box(b.data())));
+        CHECK(same(full, si->clone()->eval_box(b.data())));
+    }
+    // Specialisations specialise further, through the same cache.
+    auto deeper = sj->specialize(inner.data(), 1e12);
+    if (deeper) CHECK(deeper->instruction_count() <= sj->instruction_count());
+}
+
+TEST_CASE("the JIT declines to compile a pruned tape that would not repay it", "[llvm][prune]") {
+    const Model m = compile(csg_model);
+    const ir::Tape& tape = tape_of(m, "scene");
+    auto jt = JitEngine::make(tape);
+    // The carpet's corner: the carpet's series stays, the rest goes; one evaluation does not pay
+    // for a compile, and the interpreter is slower on the carpet's series than the JIT on the scene.
+    const std::vector<Interval> box{{0.1, 0.2}, {0.1, 0.2}};
+    CHECK_FALSE(jt->specialize(box.data(), 1));
+    CHECK(jt->specialize_stats.declined == 1);
+    CHECK(jt->specialize_stats.compiled == 0);
+    // Where only the disk is left, the interpreter runs the small pruned tape when the rule says
+    // that is faster than the JIT on the whole scene.
+    const std::vector<Interval> disk_box{{0.98, 1.02}, {0.48, 0.52}};
+    interp::ChoiceRecorder rec(tape, {});
+    const ir::Tape disk_only = ir::specialize(tape, rec.record(disk_box.data()));
+    const bool interp_faster = interp::interp_prune_costs.eval_ns_per_cost * ir::tape_cost(disk_only) <
+                               jit::jit_prune_costs.eval_ns_per_cost * ir::tape_cost(tape);
+    auto tier2 = jt->specialize(disk_box.data(), 1);
+    CHECK(bool(tier2) == interp_faster);
+    if (tier2) {
+        CHECK(tier2->engine() == "interp");
+        CHECK(tier2->instruction_count() == disk_only.instruction_count());
+        CHECK(jt->specialize_stats.fallbacks == 1);
+        CHECK(same(tier2->eval_box(disk_box.data()), jt->eval_box(disk_box.data())));
+    }
+}
+
+TEMPLATE_TEST_CASE("what pruning must not touch", "[llvm][prune]", InterpEngine, JitEngine) {
+    const Model m = compile(csg_model);
+    SECTION("an operand that may become empty on a sub-box is kept") {
+        auto e = TestType::make(tape_of(m, "partial"));
+        // x - 10 < sqrt(y) wherever sqrt(y) is defined, but sqrt(y) is empty for y < 0: pruning it
+        // would turn empty enclosures (outside) into defined ones.
+        const std::vector<Interval> across{{0, 1}, {-1, 1}};
+        CHECK_FALSE(e->specialize(across.data(), 1e12));
+        CHECK(e->specialize_stats.unpruned == 1);
+        const std::vector<Interval> above{{0, 1}, {0.25, 1}};
+        auto p = e->specialize(above.data(), 1e12);
+        REQUIRE(p);
+        CHECK(p->instruction_count() < e->instruction_count());
+    }
+    SECTION("choices inside a series are never pruned") {
+        const Model f = compile("import \"fractals\";");
+        auto e = TestType::make(tape_of(f, "carpet"));
+        const std::vector<Interval> box{{0.4, 0.6}, {0.1, 0.2}};
+        CHECK_FALSE(e->specialize(box.data(), 1e12));
+    }
+    SECTION("a decided select keeps its branch") {
+        auto e = TestType::make(tape_of(m, "chooser"));
+        const std::vector<Interval> right{{0.2, 0.8}, {-0.5, 0.5}};
+        auto p = e->specialize(right.data(), 1e12);
+        REQUIRE(p);
+        CHECK(p->instruction_count() < e->instruction_count());
+        const std::vector<Interval> sub{{0.3, 0.4}, {-0.1, 0.2}};
+        CHECK(same(p->eval_box(sub.data()), e->eval_box(sub.data())));
+        const std::vector<Interval> across{{-0.2, 0.2}, {-0.5, 0.5}};
+        CHECK_FALSE(e->specialize(across.data(), 1e12));
+    }
+    SECTION("a false operand decides an and, whatever the other") {
+        auto e = TestType::make(tape_of(m, "quadrant"));
+        // x < 0 is false, y < 0 unknown: the and is false, the select takes the disk.
+        const std::vector<Interval> box{{0.2, 0.8}, {-0.5, 0.5}};
+        auto p = e->specialize(box.data(), 1e12);
+        REQUIRE(p);
+        CHECK(p->instruction_count() < e->instruction_count() / 2); // the carpet's series is gone
+        const std::vector<Interval> sub{{0.25, 0.3}, {-0.1, 0.4}};
+        CHECK(same(p->eval_box(sub.data()), e->eval_box(sub.data())));
+    }
+    SECTION("pruning off") {
+        ir::EvalOptions off;
+        off.prune = false;
+        auto e = TestType::make(tape_of(m, "scene"), off);
+        const std::vector<Interval> box{{0.95, 1.05}, {0.45, 0.55}};
+        CHECK_FALSE(e->specialize(box.data(), 1e12));
+        CHECK(e->specialize_stats.requests == 0);
+    }
+}
+
+TEMPLATE_TEST_CASE("RSS covers are the same with and without pruning", "[llvm][prune][rss]", InterpEngine,
+                   JitEngine) {
+    // The CSG shapes of the tests, of the bench and of the examples, and every stdlib shape.
+    std::vector<std::pair<std::string, std::string>> sources = {
+        {"tests", csg_model},
+        {"bench/csg_scene.frac", read_file(std::string(FRAC_SOURCE_DIR) + "/bench/csg_scene.frac")},
+        {"examples/menger_frame.frac",
+         read_file(std::string(FRAC_SOURCE_DIR) + "/examples/menger_frame.frac")},
+    };
+    for (const std::string& file : stdlib_files()) sources.push_back({file, "import \"" + file + "\";"});
+    std::set<std::string> seen;
+    std::uint64_t pruned_evaluations = 0;
+    for (const auto& [where, text] : sources) {
+        const Model m = compile(text);
+        for (std::size_t i = 0; i < m.tapes.size(); ++i) {
+            const front::ShapeInfo& s = m.shape(i);
+            if (!seen.insert(s.name).second) continue;
+            INFO(where << ": shape " << s.name);
+            ir::EvalOptions off;
+            off.prune = false;
+            auto plain = TestType::make(m.tapes[i], off);
+            auto pruning = TestType::make(m.tapes[i]);
+            rt::RssOptions o;
+            o.depth = s.dimension == 2 ? 7 : 4;
+            o.threads = 2; // pruned variants are evaluated per thread too
+            const rt::RssResult a = rt::subdivide(*plain, s.box, o);
+            const rt::RssResult b = rt::subdivide(*pruning, s.box, o);
+            CHECK(rt::same_cover(a, b));
+            CHECK(a.pruned_evaluations == 0);
+            pruned_evaluations += b.pruned_evaluations;
+        }
+    }
+    // The interpreter prunes the CSG shapes (the JIT at these depths compiles none: too few boxes).
+    if (std::string(TestType::name) == "interp") CHECK(pruned_evaluations > 1000);
+}
+
+TEST_CASE("pruned covers are identical across engines", "[llvm][prune][rss]") {
+    const Model m = compile(read_file(std::string(FRAC_SOURCE_DIR) + "/bench/csg_scene.frac"));
+    const front::ShapeInfo& s = info_of(m, "csg_scene");
+    auto in = InterpEngine::make(tape_of(m, "csg_scene"));
+    auto jt = JitEngine::make(tape_of(m, "csg_scene"));
+    rt::RssOptions o;
+    o.depth = 8;
+    const rt::RssResult a = rt::subdivide(*in, s.box, o);
+    const rt::RssResult b = rt::subdivide(*jt, s.box, o);
+    CHECK(rt::same_cover(a, b));
+    CHECK(a.pruned_evaluations > a.evaluated / 2);
+    CHECK(in->specialize_stats.requests > 0);
+    CHECK(jt->specialize_stats.requests == in->specialize_stats.requests);
+    // Which cells evaluate which pruned function does not depend on the thread count.
+    auto in2 = InterpEngine::make(tape_of(m, "csg_scene"));
+    o.threads = 2;
+    const rt::RssResult c = rt::subdivide(*in2, s.box, o);
+    CHECK(rt::same_cover(a, c));
+    CHECK(c.pruned_evaluations == a.pruned_evaluations);
+    CHECK(c.specializations == a.specializations);
+    CHECK(in2->stats.series_terms == in->stats.series_terms);
+}
+
+TEMPLATE_TEST_CASE("a 3D CSG cover is the same with and without pruning", "[llvm][prune][rss]", InterpEngine,
+                   JitEngine) {
+    const Model m = compile(read_file(std::string(FRAC_SOURCE_DIR) + "/examples/menger_frame.frac"));
+    const front::ShapeInfo& s = info_of(m, "sponge_in_frame");
+    ir::EvalOptions off;
+    off.prune = false;
+    auto plain = TestType::make(tape_of(m, "sponge_in_frame"), off);
+    auto pruning = TestType::make(tape_of(m, "sponge_in_frame"));
+    rt::RssOptions o;
+    o.depth = 7; // deep enough for cells prune_min_remaining levels above the depth to be split
+    o.keep_cells = true;
+    o.threads = 2;
+    const rt::RssResult a = rt::subdivide(*plain, s.box, o);
+    const rt::RssResult b = rt::subdivide(*pruning, s.box, o);
+    CHECK(rt::same_cover(a, b));
+    CHECK(pruning->specialize_stats.requests > 0);
+    if (std::string(TestType::name) == "interp") CHECK(b.pruned_evaluations > 0);
+}
