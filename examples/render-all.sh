@@ -23,7 +23,7 @@ render fig10_double_koch.frac double_flake 8
 render_as fig11_koch_levels.frac flake0 8 fig11_flake0
 render_as fig11_koch_levels.frac flake1 8 fig11_flake1
 render_as fig11_koch_levels.frac flake2 8 fig11_flake2
-render fig13_koch_polar.frac koch_flake 7
+render fig13_koch_polar.frac koch_flake 9
 # The 3D-printable example: a watertight STL of the sponge in its frame.
 "$frac" mesh "$here/menger_frame.frac" sponge_in_frame --depth 4 --split 3 --select cover -o "$out/menger_frame.stl"
 echo

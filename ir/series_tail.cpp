@@ -1,11 +1,17 @@
 #include "ir/series_tail.hpp"
 
 #include <cmath>
+#include <fmt/format.h>
+#include <limits>
 #include <stdexcept>
 
 namespace frac::ir {
 
 using namespace frac::num;
+
+namespace {
+constexpr double inf = std::numeric_limits<double>::infinity();
+}
 
 Interval series_term_bound(Interval a, Interval b, bool has_b, Interval gamma_i, std::int64_t i) {
     const Interval coeff = has_b ? add(a, mul(b, Interval(static_cast<double>(i)))) : a;
@@ -59,6 +65,45 @@ Interval series_tail(Op kind, Interval a, Interval b, bool has_b, Interval gamma
     default: break;
     }
     throw std::logic_error("series_tail: not a series op");
+}
+
+double escape_bound(Op kind, const OrbitEscape& e, const Interval* state, int dims, std::int64_t n) {
+    const double none = kind == Op::SeriesMax ? inf : -inf;
+    Interval norm2(0.0);
+    for (int c = 0; c < dims; ++c) norm2 = add(norm2, sqr(state[c]));
+    const Interval norm = sqrt(norm2);
+    if (!(norm.lo > e.radius)) return none; // not provably outside the ball (NaN included)
+    // (slope (|q| - radius) + offset) * scale0 / growth^n, enclosed over the box; its lower end.
+    const Interval excess = add(mul(Interval(e.slope), sub(norm, Interval(e.radius))), Interval(e.offset));
+    const Interval bound = mul(excess, div(e.scale0, powi(e.growth, n)));
+    if (!(bound.lo > -inf)) return none;
+    return kind == Op::SeriesMax ? -bound.lo : bound.lo;
+}
+
+Interval escape_tighten(Op kind, Interval tail, double bound) {
+    if (kind == Op::SeriesMax) {
+        const double hi = bound < tail.hi ? bound : tail.hi;
+        return {hi < tail.lo ? hi : tail.lo, hi};
+    }
+    const double lo = bound > tail.lo ? bound : tail.lo;
+    return {lo, lo > tail.hi ? lo : tail.hi};
+}
+
+bool escape_point_done(Op kind, const OrbitEscape& e, double acc, const double* state, int dims,
+                       std::int64_t n) {
+    double norm2 = 0.0;
+    for (int c = 0; c < dims; ++c) norm2 += state[c] * state[c];
+    const double norm = std::sqrt(norm2);
+    if (!(norm > e.radius)) return false;
+    const double bound = (e.slope * (norm - e.radius) + e.offset) *
+                         (e.scale0.lo / std::pow(e.growth.lo, static_cast<double>(n)));
+    const double slack = 0x1p-54 * std::fabs(acc);
+    return kind == Op::SeriesMax ? -bound <= acc + slack : bound >= acc - slack;
+}
+
+std::string escape_text(const OrbitEscape& e) {
+    return fmt::format(" escape |q| > {}: terms >= ({} (|q| - {}) + {}) * [{}, {}] / [{}, {}]^i", e.radius,
+                       e.slope, e.radius, e.offset, e.scale0.lo, e.scale0.hi, e.growth.lo, e.growth.hi);
 }
 
 Interval series_combine(Op kind, Interval acc, Interval term) {

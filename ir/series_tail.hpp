@@ -5,6 +5,8 @@
 
 #include "ir/graph.hpp"
 
+#include <string>
+
 namespace frac::ir {
 
 // Enclosure of the tail: for a sum, of sum_{i>n} t_i; for a min (max), of inf (sup) over i>n of t_i,
@@ -13,6 +15,19 @@ Interval series_tail(Op kind, Interval a, Interval b, bool has_b, Interval gamma
 
 // Enclosure of the bound of the single term i: (A + B i) gamma^i, with gamma_i = gamma^i given.
 Interval series_term_bound(Interval a, Interval b, bool has_b, Interval gamma_i, std::int64_t i);
+
+// Escape certificates of orbit series (ir::OrbitEscape). `escape_bound` is the bound of every term
+// after index n - 1 given the orbit point q_n (`state`, `dims` components, as a box): a lower bound for
+// a min series, an upper bound for a max series; -inf (+inf) when the box does not lie outside the
+// escape ball. `escape_tighten` intersects a tail enclosure with it; every engine uses these two.
+double escape_bound(Op kind, const OrbitEscape& e, const Interval* state, int dims, std::int64_t n);
+Interval escape_tighten(Op kind, Interval tail, double bound);
+std::string escape_text(const OrbitEscape& e); // for the printers
+// Point evaluation (round to nearest, no enclosure): true when the terms after index n - 1, bounded by
+// the certificate from the orbit point q_n, cannot move the partial result `acc` by more than its
+// last bit; the point value is then `acc`.
+bool escape_point_done(Op kind, const OrbitEscape& e, double acc, const double* state, int dims,
+                       std::int64_t n);
 
 // Combines a partial result with one more term (or with a tail).
 Interval series_combine(Op kind, Interval acc, Interval term);

@@ -142,7 +142,8 @@ private:
                     resolved = true;
                     break;
                 }
-                const Interval tail = ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i);
+                const Interval tail =
+                    escape_tail(s, ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i), i);
                 if (num::width(tail) <= 0x1p-52 * num::magnitude(acc) || num::width(tail) == 0) {
                     resolved = true;
                     break;
@@ -158,7 +159,18 @@ private:
         }
         if (!infinite) return acc;
         if (!resolved) ++stats.series_capped;
-        return ir::series_combine(s.kind, acc, ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i));
+        return ir::series_combine(s.kind, acc,
+                                  escape_tail(s, ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i), i));
+    }
+
+    // The tail after index i tightened by the series' escape certificate, from the orbit point q_{i+1}.
+    Interval escape_tail(const TapeSeries& s, Interval tail, std::int64_t i) const {
+        if (!s.data.escape.present) return tail;
+        Interval state[8];
+        for (std::size_t c = 0; c < s.state_slots.size(); ++c) state[c] = boxes_[s.state_slots[c]];
+        return ir::escape_tighten(
+            s.kind, tail,
+            ir::escape_bound(s.kind, s.data.escape, state, static_cast<int>(s.state_slots.size()), i + 1));
     }
 
     double series_point(const TapeSeries& s) {
@@ -182,7 +194,16 @@ private:
             acc = i == s.data.start ? term : ir::series_combine_point(s.kind, acc, term);
             ++stats.series_terms;
             if (i == last) break;
-            if (infinite) {
+            if (infinite && s.data.escape.present) {
+                // The escape certificate bounds every later term from the orbit point q_{i+1}.
+                double state[8];
+                for (std::size_t c = 0; c < s.state_slots.size(); ++c) state[c] = points_[s.state_slots[c]];
+                if (ir::escape_point_done(s.kind, s.data.escape, acc, state,
+                                          static_cast<int>(s.state_slots.size()), i + 1)) {
+                    resolved = true;
+                    break;
+                }
+            } else if (infinite) {
                 // Estimate of the tail's size: stop once it is below half an ulp of the sum.
                 const double n1 = static_cast<double>(i + 1);
                 const double tail = (a + b * n1) * gamma_next * (n1 + 1.0) / ((1.0 - gamma) * (1.0 - gamma));
@@ -195,6 +216,7 @@ private:
         }
         if (!infinite) return acc;
         if (!resolved) ++stats.series_capped;
+        if (s.data.escape.present) return acc; // the terms' bound is one-sided: no tail estimate
         Interval tail;
         {
             num::UpwardRounding up;

@@ -27,6 +27,7 @@
 #include <llvm/IR/IntrinsicsX86.h>
 #include <llvm/IR/Module.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -107,18 +108,25 @@ public:
         capped_ = b_.CreateAlloca(i64_, nullptr, "capped");
         b_.CreateStore(b_.getInt64(0), terms_);
         b_.CreateStore(b_.getInt64(0), capped_);
+        // Scratch memory of the helpers, aligned for whole-vector loads and stores.
+        auto aligned = [&](Type* t, const char* what) {
+            llvm::AllocaInst* a = b_.CreateAlloca(t, nullptr, what);
+            a->setAlignment(llvm::Align(64));
+            return a;
+        };
         if (w_ > 1) {
-            // Scratch memory of the vector helpers: up to three interval operands in, one out.
-            // Aligned for whole-vector loads and stores.
-            auto aligned = [&](Type* t, const char* what) {
-                llvm::AllocaInst* a = b_.CreateAlloca(t, nullptr, what);
-                a->setAlignment(llvm::Align(64));
-                return a;
-            };
+            // The vector helpers: up to three interval operands in, one out.
             scratch_in_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(6 * w_)), "vin");
             scratch_n_ = aligned(llvm::ArrayType::get(i64_, static_cast<std::uint64_t>(w_)), "vn");
             scratch_out_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(2 * w_)), "vout");
             sink_ = aligned(llvm::ArrayType::get(dbl_, 2), "sink");
+        }
+        if (std::any_of(t_.series.begin(), t_.series.end(),
+                        [](const TapeSeries& s) { return s.data.escape.present; })) {
+            // The escape helper: up to 8 orbit components in, one bound per lane out.
+            esc_in_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(16 * w_)), "ein");
+            esc_n_ = aligned(llvm::ArrayType::get(i64_, static_cast<std::uint64_t>(w_)), "en");
+            esc_out_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(w_)), "eout");
         }
         b_.CreateCondBr(b_.CreateICmpEQ(n, b_.getInt64(0)), done, loop);
 
@@ -750,6 +758,39 @@ private:
                       true);
     }
 
+    // ir::escape_bound of the orbit point `state` (index n, scalar) for the lanes in `mask`.
+    Value* escape_bound(const TapeSeries& s, const std::vector<IV>& state, Value* n, Value* mask) {
+        const auto w = static_cast<std::uint64_t>(w_);
+        for (std::size_t c = 0; c < state.size(); ++c) {
+            b_.CreateStore(state[c].lo, b_.CreateConstInBoundsGEP1_64(dbl_, esc_in_, 2 * c * w));
+            b_.CreateStore(state[c].hi, b_.CreateConstInBoundsGEP1_64(dbl_, esc_in_, (2 * c + 1) * w));
+        }
+        b_.CreateStore(splat(n), esc_n_);
+        auto callee = m_.getOrInsertFunction(
+            "frac_jit_vescape",
+            llvm::FunctionType::get(
+                Type::getVoidTy(ctx_),
+                {i32_, ptr_, ptr_, ptr_, i32_, dbl_, dbl_, dbl_, dbl_, dbl_, dbl_, dbl_, i32_, i32_}, false));
+        llvm::cast<Function>(callee.getCallee())->setDoesNotThrow();
+        const ir::OrbitEscape& e = s.data.escape;
+        auto d = [&](double x) { return llvm::ConstantFP::get(dbl_, x); };
+        b_.CreateCall(callee, {b_.getInt32(static_cast<std::uint32_t>(s.kind)), esc_in_, esc_n_, esc_out_,
+                               b_.getInt32(static_cast<std::uint32_t>(state.size())), d(e.radius), d(e.slope),
+                               d(e.offset), d(e.scale0.lo), d(e.scale0.hi), d(e.growth.lo), d(e.growth.hi),
+                               w_ == 1 ? b_.getInt32(1) : mask_bits(mask),
+                               b_.getInt32(static_cast<std::uint32_t>(w_))});
+        return b_.CreateLoad(vt_, esc_out_);
+    }
+    // ir::escape_tighten: the tail intersected with the escape bound; its signs are no longer known.
+    SlotState escape_tighten(Op kind, const SlotState& tail, Value* bound) {
+        if (kind == Op::SeriesMax) {
+            Value* hi = sel(lt(bound, tail.v.hi), bound, tail.v.hi);
+            return result({sel(lt(hi, tail.v.lo), hi, tail.v.lo), hi}, true);
+        }
+        Value* lo = sel(gt(bound, tail.v.lo), bound, tail.v.lo);
+        return result({lo, sel(gt(lo, tail.v.hi), lo, tail.v.hi)}, true);
+    }
+
     SlotState emit_series(const Instr& ins) {
         const TapeSeries& s = t_.series[ins.series];
         const SeriesTables& st = tab_.series[ins.series];
@@ -790,6 +831,12 @@ private:
             sc.f = tab_.slot_facts[s.state_slots[c]];
             states_[s.state_slots[c]] = sc;
         }
+        const bool escape = infinite && s.data.escape.present;
+        llvm::PHINode* esc_frozen = nullptr; // escape certificate: each lane's bound where it stopped
+        if (escape) {
+            esc_frozen = b_.CreatePHI(vt_, 2, "esc.frozen");
+            esc_frozen->addIncoming(cst(s.kind == Op::SeriesMax ? inf : -inf), pre);
+        }
         Value* idx = b_.CreateSub(i, start_v, "idx");
         idx_[ins.series] = idx;
         const bool exact = std::max(std::fabs(static_cast<double>(start)), std::fabs(static_cast<double>(last))) < 0x1p52;
@@ -802,6 +849,9 @@ private:
         std::vector<IV> next_state;
         for (std::size_t c = 0; c < s.state_slots.size(); ++c) next_state.push_back(states_[s.update_slots[c]].v);
         const SlotState term = states_[s.body_slot];
+        // Escape certificate: the bound of the terms after i from the next orbit point.
+        Value* esc_now =
+            escape ? escape_bound(s, next_state, b_.CreateAdd(i, b_.getInt64(1)), active) : nullptr;
         const SlotState acc = result({acc_lo, acc_hi}, term.f.maybe_empty);
         const SlotState comb = combine(s.kind, acc, term);
         Value* first = splat(b_.CreateICmpEQ(i, start_v));
@@ -813,6 +863,8 @@ private:
         // At the last index every active lane stops, capped by the term limit (infinite series).
         Value* splat_i = w_ == 1 ? static_cast<Value*>(i) : b_.CreateVectorSplat(static_cast<unsigned>(w_), i);
         Value* last_at = w_ == 1 ? static_cast<Value*>(i) : b_.CreateSelect(active, splat_i, stop_at);
+        Value* esc_last = escape ? (w_ == 1 ? esc_now : sel(active, esc_now, esc_frozen)) : nullptr;
+        Value* esc_next = esc_frozen;
         BasicBlock* from_last = b_.GetInsertBlock();
         BasicBlock* latch = BasicBlock::Create(ctx_, "series.next", fn_);
         Value* still = active;        // lanes that go on to the next term
@@ -858,6 +910,10 @@ private:
                 tail = tail_core(s, a, bc, has_b, i, rest);
                 tail_width = width(tail);
             }
+            if (escape) {
+                tail = escape_tighten(s.kind, tail, esc_now);
+                tail_width = width(tail);
+            }
             Value* small = b_.CreateOr(le(tail_width, mul(cst(0x1p-52), magnitude(nacc))), eq(tail_width, cst(0.0)));
             if (s.kind == Op::SeriesMin) {
                 Value* one_sided = eq(fabs(tail.v.hi), cst(inf));
@@ -877,6 +933,7 @@ private:
             stop->addIncoming(stop2, check2_end);
             still = land(active, lnot(stop));
             stop_at_next = b_.CreateSelect(stop, splat_i, stop_at);
+            if (escape) esc_next = sel(stop, esc_now, esc_frozen);
             decided = b_.GetInsertBlock();
             b_.CreateCondBr(any(still), latch, exit);
         }
@@ -888,6 +945,7 @@ private:
         acc_hi->addIncoming(nacc.v.hi, latch);
         active->addIncoming(still, latch);
         stop_at->addIncoming(stop_at_next, latch);
+        if (escape) esc_frozen->addIncoming(esc_next, latch);
         for (std::size_t c = 0; c < state_phis.size(); ++c) {
             state_phis[c].first->addIncoming(next_state[c].lo, latch);
             state_phis[c].second->addIncoming(next_state[c].hi, latch);
@@ -903,6 +961,12 @@ private:
         final_at->addIncoming(last_at, from_last);
         capped_lanes->addIncoming(i1(false), decided);
         final_at->addIncoming(stop_at_next, decided);
+        llvm::PHINode* esc_final = nullptr;
+        if (escape) {
+            esc_final = b_.CreatePHI(vt_, 2, "esc.final");
+            esc_final->addIncoming(esc_last, from_last);
+            esc_final->addIncoming(esc_next, decided);
+        }
         bump(capped_, count(capped_lanes));
         Value* final_idx = b_.CreateSub(final_at, w_ == 1 ? start_v : b_.CreateVectorSplat(static_cast<unsigned>(w_), start_v));
         SlotState tail;
@@ -910,6 +974,7 @@ private:
             tail = from_table(gather_pair(table(&st.tail, st.tail, "tail"), final_idx), facts_of(st.tail.data(), st.tail.size()));
         else
             tail = tail_core(s, a, bc, has_b, final_at, outer_mask);
+        if (escape) tail = escape_tighten(s.kind, tail, esc_final);
         return combine(s.kind, nacc, tail);
     }
 
@@ -948,6 +1013,9 @@ private:
     Value* scratch_in_ = nullptr;
     Value* scratch_n_ = nullptr;
     Value* scratch_out_ = nullptr;
+    Value* esc_in_ = nullptr; // escape helper scratch (series with an escape certificate only)
+    Value* esc_n_ = nullptr;
+    Value* esc_out_ = nullptr;
     Value* sink_ = nullptr;
     Value* ctx_mask_ = nullptr; // lanes the current code computes for
     std::vector<SlotState> states_;

@@ -42,6 +42,16 @@ void frac_jit_vop(int op, std::int64_t imm, const double* in, double* out, std::
 // ir::series_tail per lane: in holds A.lo, A.hi, B.lo, B.hi (lanes each), n the index of each lane.
 void frac_jit_vtail(int kind, const double* in, const std::int64_t* n, double* out, int has_b, double gamma_lo,
                     double gamma_hi, std::uint32_t mask, int lanes) noexcept;
+// ir::escape_bound per lane: in holds, for each orbit component c, lanes lower bounds then lanes upper
+// bounds (in[2 c lanes + l], in[(2 c + 1) lanes + l]); n the index of each lane's orbit point; the
+// certificate's fields as arguments. Lanes outside the mask get the "no bound" value.
+void frac_jit_vescape(int kind, const double* in, const std::int64_t* n, double* out, int dims, double radius,
+                      double slope, double offset, double scale0_lo, double scale0_hi, double growth_lo,
+                      double growth_hi, std::uint32_t mask, int lanes) noexcept;
+// ir::escape_point_done for the orbit point state[0..dims) (round to nearest): 1 when done.
+int frac_jit_escape_point_done(int kind, double acc, const double* state, int dims, std::int64_t n,
+                               double radius, double slope, double offset, double scale0_lo, double scale0_hi,
+                               double growth_lo, double growth_hi) noexcept;
 // Point operations (round to nearest), the C library's functions as the interpreter calls them.
 double frac_jit_pow_point(double x, double y) noexcept;
 double frac_jit_sin_point(double x) noexcept;
