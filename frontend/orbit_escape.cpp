@@ -276,7 +276,7 @@ private:
         }
         if (!(best.a > 0))
             throw Unproven{"the map is not recognised as growing with |q| (expected l * u(q) + c with u a "
-                          "rotation, reflection or polar re-assembly of q)"};
+                           "rotation, reflection or polar re-assembly of q)"};
         return best;
     }
 
@@ -452,7 +452,7 @@ std::optional<ir::OrbitEscape> prove_orbit_escape(Graph& g, NodeId term, const s
         const double r = radius.hi;
         if (!(a > 1))
             throw Unproven{fmt::format("the map only gives |M(q)| >= {} |q| - {}, which does not grow",
-                                      num_text(a), num_text(b))};
+                                       num_text(a), num_text(b))};
         if (!(a >= split.growth.hi))
             throw Unproven{
                 fmt::format("the map gives |M(q)| >= {} |q| - {}, slower than the term's scale shrinks "
