@@ -57,6 +57,10 @@ TEST_CASE("every grammar production parses", "[grammar]") {
         {"series infinite", "fn f(x) = sum(i in 0.., x / 2^i);", "(fn f (x) (sum i 0 inf (/ x (^ 2 i))))\n"},
         {"series finite", "fn f(x) = min(k in 1..5, x);", "(fn f (x) (min k 1 5 x))\n"},
         {"max call is not a series", "fn f(x) = max(x, 1);", "(fn f (x) (call max x 1))\n"},
+        {"orbit", "fn f(x) = min(k in 0..3, p in orbit((x, 0), m), p.x);",
+         "(fn f (x) (min k 0 3 (orbit p (point x 0) m) (. x p)))\n"},
+        {"orbit escape", "fn f(x) = min(k in 0.., p in orbit((x, 0), m) escape 1/2, p.x / 3^k);",
+         "(fn f (x) (min k 0 inf (orbit p (point x 0) m (escape (/ 1 2))) (/ (. x p) (^ 3 k))))\n"},
         {"comments", "// line\n/* block */ const c = 1; // end", "(const c 1)\n"},
     };
     for (const Case& c : cases) {
