@@ -664,6 +664,8 @@ private:
         }
         if (!bound) fail(e.loc, "cannot bound this infinite series: " + why);
         data.gamma = bound->gamma;
+        data.one_sided = kind == Op::SeriesMin ? !bound->no_upper.empty()
+                                               : kind == Op::SeriesMax && !bound->no_lower.empty();
         if (escape_radius != ir::no_node)
             data.escape = prove_escape(e, kind, body, orbit, data, escape_radius);
         return Value::scalar(g_.series(kind, data, body, bound->a, bound->b, orbit));

@@ -59,6 +59,9 @@ struct SeriesData {
     Interval gamma{0.0, 0.0};        // decay, proven 0 < gamma.hi < 1 for infinite series
     int state_count = 0;             // orbit series: components of the orbit point
     OrbitEscape escape;              // orbit series: optional escape certificate
+    // The term bound is one-sided (A infinite on one side): the tail says nothing about the value's
+    // other side, so point evaluation cannot estimate the tail from A's point value.
+    bool one_sided = false;
     bool operator==(const SeriesData&) const = default;
 };
 

@@ -203,7 +203,7 @@ private:
                     resolved = true;
                     break;
                 }
-            } else if (infinite) {
+            } else if (infinite && !s.data.one_sided) {
                 // Estimate of the tail's size: stop once it is below half an ulp of the sum.
                 const double n1 = static_cast<double>(i + 1);
                 const double tail = (a + b * n1) * gamma_next * (n1 + 1.0) / ((1.0 - gamma) * (1.0 - gamma));
@@ -216,7 +216,7 @@ private:
         }
         if (!infinite) return acc;
         if (!resolved) ++stats.series_capped;
-        if (s.data.escape.present) return acc; // the terms' bound is one-sided: no tail estimate
+        if (s.data.escape.present || s.data.one_sided) return acc; // no tail estimate from a one-sided bound
         Interval tail;
         {
             num::UpwardRounding up;

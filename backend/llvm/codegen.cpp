@@ -270,8 +270,8 @@ private:
         bump(terms_, b_.getInt64(1));
         Value* is_last = b_.CreateICmpEQ(i, b_.getInt64(static_cast<std::uint64_t>(last)));
         Value* gnext2 = gnext;
-        if (!infinite) {
-            b_.CreateCondBr(is_last, exit, latch);
+        if (!infinite || (s.data.one_sided && !s.data.escape.present)) {
+            b_.CreateCondBr(is_last, exit, latch); // a one-sided bound gives no tail estimate
         } else if (s.data.escape.present) {
             // The escape certificate bounds every later term from the orbit point q_{i+1}.
             BasicBlock* check = BasicBlock::Create(ctx_, "series.escape", fn_);
@@ -315,7 +315,7 @@ private:
         b_.SetInsertPoint(exit);
         if (!infinite) return nacc;
         bump(capped_, b_.CreateZExt(is_last, i64_));
-        if (s.data.escape.present) return nacc; // the terms' bound is one-sided: no tail estimate
+        if (s.data.escape.present || s.data.one_sided) return nacc; // no tail estimate from a one-sided bound
         // The tail's midpoint, from ir::series_tail under upward rounding (as the interpreter does).
         Function* end_fn = declare("frac_jit_point_series_end", dbl_, {i32_, dbl_, dbl_, dbl_, i32_, dbl_, dbl_, i64_});
         return b_.CreateCall(end_fn, {b_.getInt32(static_cast<std::uint32_t>(s.kind)), nacc, vals_[s.tail_a],
