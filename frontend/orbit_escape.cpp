@@ -145,12 +145,37 @@ public:
             c_norm2 = num::add(c_norm2, num::sqr(lin.constant));
             const Interval mag = num::abs(coeff);
             l_min = std::min(l_min, mag.lo);
+            l_max_ = std::max(l_max_, mag.hi);
         }
         const Affine u = norm_of_parts(parts);
         // |M(q)| >= l_min |u(q)| - |c| >= l_min (u.a |q| + u.b) - |c|
         const double a = num::mul(Interval(l_min), Interval(u.a)).lo;
         const double b = num::sub(num::sqrt(c_norm2), num::mul(Interval(l_min), Interval(u.b))).hi;
         return {a, b};
+    }
+
+    // A Lipschitz constant of the map (Euclidean), or inf. Valid after map_growth.
+    double map_lipschitz() const { return num::mul(Interval(l_max_), Interval(u_lipschitz_)).hi; }
+
+    // A Lipschitz constant of a function of the orbit point, or inf.
+    double lipschitz(NodeId id) {
+        const ir::Node& n = g_[id];
+        if (!reads_state(id)) return n.op == Op::Const ? 0.0 : inf;
+        if (is_norm(id) || state_component(id) >= 0) return 1.0;
+        switch (n.op) {
+        case Op::Add:
+        case Op::Sub: return num::add(Interval(lipschitz(n.args[0])), Interval(lipschitz(n.args[1]))).hi;
+        case Op::Neg:
+        case Op::Abs:
+        case Op::Dz:
+        case Op::Sin:
+        case Op::Cos: return lipschitz(n.args[0]); // 1-Lipschitz functions
+        case Op::Min:
+        case Op::Max: return std::max(lipschitz(n.args[0]), lipschitz(n.args[1]));
+        case Op::Mul:
+        case Op::Div: return scaled_lipschitz(n, [&](NodeId x) { return lipschitz(x); });
+        default: return inf;
+        }
     }
 
     // The term as D(q) * scale0 / growth^k.
@@ -250,6 +275,10 @@ private:
             if (split_trig(parts[0].factors, Op::Cos, f0, r0) &&
                 split_trig(parts[1].factors, Op::Sin, f1, r1) && f0 == f1 && r0 == r1 && r0.size() <= 1) {
                 if (r0.empty()) return {0.0, 1.0};
+                // (|q| cos g(t), |q| sin g(t)), t the angle of a reflection of q: |du|^2 = d|q|^2 +
+                // |q|^2 g'^2 dt^2 along any segment, so u is max(1, |g'|)-Lipschitz.
+                const NodeId t = reflected_angle(f0);
+                if (is_norm(r0[0]) && t != no_node) u_lipschitz_ = std::max(1.0, angle_lipschitz(f0, t));
                 return radial(r0[0]).lower;
             }
         }
@@ -266,7 +295,10 @@ private:
             const int c = state_component(f);
             if (c < 0 || c >= dims_ || seen[static_cast<std::size_t>(c)]++) permutation = false;
         }
-        if (permutation) return {1.0, 0.0};
+        if (permutation) {
+            u_lipschitz_ = 1.0; // abs and signed permutations are 1-Lipschitz
+            return {1.0, 0.0};
+        }
         // Otherwise |u| >= |u_k| >= u_k for the component with the largest lower slope.
         Affine best{0.0, 0.0};
         for (const Monomial& p : parts) {
@@ -420,6 +452,58 @@ private:
         s.growth = num::mul(s.growth, g);
     }
 
+    // c * x or x / c for a constant c: |c| Lip(x); inf otherwise.
+    template <class Lip>
+    double scaled_lipschitz(const ir::Node& n, Lip lip) {
+        const bool div = n.op == Op::Div;
+        const NodeId c = div ? n.args[1] : (g_.is_const(n.args[0]) ? n.args[0] : n.args[1]);
+        if (!g_.is_const(c)) return inf;
+        const NodeId x = c == n.args[0] ? n.args[1] : n.args[0];
+        const Interval k = num::abs(div ? num::div(Interval(1.0), g_[c].value) : g_[c].value);
+        return num::mul(k, Interval(lip(x))).hi;
+    }
+    // The atan2(|q_i|, +-q_j) (i != j, 2D) node that f depends on: the angle in [0, pi] of a reflection
+    // of q, continuous away from the origin. no_node when f reads the point otherwise.
+    NodeId reflected_angle(NodeId f) {
+        const ir::Node& n = g_[f];
+        if (n.op == Op::Atan2) {
+            const ir::Node& y = g_[n.args[0]];
+            NodeId x = n.args[1];
+            if (g_[x].op == Op::Neg) x = g_[x].args[0];
+            const int i = y.op == Op::Abs ? state_component(y.args[0]) : -1, j = state_component(x);
+            return i >= 0 && j >= 0 && i != j && dims_ == 2 ? f : no_node;
+        }
+        NodeId found = no_node;
+        for (NodeId a : n.args) {
+            if (a == no_node || !reads_state(a)) continue;
+            const NodeId t = reflected_angle(a);
+            if (t == no_node || (found != no_node && found != t)) return no_node;
+            found = t;
+        }
+        return found;
+    }
+    // A Lipschitz constant of f as a function of the node `angle`, through continuous operations; inf
+    // otherwise.
+    double angle_lipschitz(NodeId f, NodeId angle) {
+        if (f == angle) return 1.0;
+        const ir::Node& n = g_[f];
+        if (!reads_state(f)) return n.op == Op::Const ? 0.0 : inf;
+        switch (n.op) {
+        case Op::Add:
+        case Op::Sub:
+            return num::add(Interval(angle_lipschitz(n.args[0], angle)),
+                            Interval(angle_lipschitz(n.args[1], angle)))
+                .hi;
+        case Op::Neg:
+        case Op::Abs:
+        case Op::Dz: return angle_lipschitz(n.args[0], angle);
+        case Op::Mul:
+        case Op::Div: return scaled_lipschitz(n, [&](NodeId x) { return angle_lipschitz(x, angle); });
+        default: return inf;
+        }
+    }
+
+    double l_max_ = 0.0, u_lipschitz_ = inf;
     Graph& g_;
     int level_, dims_;
     std::unordered_map<NodeId, bool> state_memo_, index_memo_;
@@ -472,6 +556,13 @@ std::optional<ir::OrbitEscape> prove_orbit_escape(Graph& g, NodeId term, const s
         e.offset = std::min(0.0, num::add(num::mul(Interval(lower.a), Interval(r)), Interval(lower.b)).lo);
         e.scale0 = split.scale0;
         e.growth = split.growth;
+        // Lipschitz bounds in the initial point: the term of index k is lipschitz * (map_lipschitz /
+        // growth)^k - Lipschitz (Lip(D) S0 Lip(M)^k / g^k), and so is the bound above (slope <= Lip(D)).
+        const double lip_map = p.map_lipschitz(), lip_d = p.lipschitz(split.d);
+        if (std::isfinite(lip_map) && std::isfinite(lip_d)) {
+            e.lipschitz = num::mul(Interval(std::max(lip_d, e.slope)), split.scale0).hi;
+            e.map_lipschitz = lip_map;
+        }
         return e;
     } catch (const Unproven& f) {
         why = f.why;

@@ -31,7 +31,8 @@ bool same_escape(const OrbitEscape& a, const OrbitEscape& b) {
     return a.present == b.present && bits(a.radius) == bits(b.radius) && bits(a.slope) == bits(b.slope) &&
            bits(a.offset) == bits(b.offset) && bits(a.scale0.lo) == bits(b.scale0.lo) &&
            bits(a.scale0.hi) == bits(b.scale0.hi) && bits(a.growth.lo) == bits(b.growth.lo) &&
-           bits(a.growth.hi) == bits(b.growth.hi);
+           bits(a.growth.hi) == bits(b.growth.hi) && bits(a.lipschitz) == bits(b.lipschitz) &&
+           bits(a.map_lipschitz) == bits(b.map_lipschitz);
 }
 
 void mix(std::size_t& h, std::uint64_t v) {

@@ -49,6 +49,11 @@ struct OrbitEscape {
     double offset = 0.0;
     Interval scale0{1.0, 1.0};
     Interval growth{1.0, 1.0};
+    // When > 0: the term of index j is lipschitz * (map_lipschitz / growth)^j - Lipschitz in the orbit's
+    // initial point, and |M(q) - M(q')| <= map_lipschitz |q - q'| (Euclidean): a box may be evaluated
+    // at its centre and widened (ir::lipschitz_finish).
+    double lipschitz = 0.0;
+    double map_lipschitz = 0.0;
     bool operator==(const OrbitEscape&) const = default;
 };
 

@@ -126,6 +126,10 @@ private:
         bool resolved = !infinite;
         for (std::size_t c = 0; c < s.state_slots.size(); ++c)
             boxes_[s.state_slots[c]] = boxes_[s.init_slots[c]];
+        // A proven Lipschitz bound: run the orbit from the centre of the initial box, widen at the end.
+        const double h = infinite && s.data.escape.lipschitz > 0 ? centre_orbit(s) : 0.0;
+        const bool escape = infinite && s.data.escape.present;
+        double escape_prev = s.kind == Op::SeriesMax ? num::inf : -num::inf;
         for (;; ++i) {
             boxes_[s.index_slot] = Interval(static_cast<double>(i));
             run_boxes(s.block);
@@ -142,8 +146,14 @@ private:
                     resolved = true;
                     break;
                 }
-                const Interval tail =
-                    escape_tail(s, ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i), i);
+                Interval tail = ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i);
+                double escape_now = 0.0;
+                if (escape) {
+                    Interval state[8];
+                    const int dims = load_state(s, state);
+                    escape_now = ir::escape_bound(s.kind, s.data.escape, state, dims, i + 1);
+                    tail = ir::escape_tighten(s.kind, tail, escape_now);
+                }
                 if (num::width(tail) <= 0x1p-52 * num::magnitude(acc) || num::width(tail) == 0) {
                     resolved = true;
                     break;
@@ -154,23 +164,35 @@ private:
                     resolved = true;
                     break;
                 }
+                if (escape && ir::escape_stalls(s.kind, escape_now, escape_prev, acc)) {
+                    resolved = true;
+                    break;
+                }
+                escape_prev = escape_now;
                 gamma_i = num::mul(gamma_i, s.data.gamma);
             }
         }
         if (!infinite) return acc;
         if (!resolved) ++stats.series_capped;
-        return ir::series_combine(s.kind, acc,
-                                  escape_tail(s, ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i), i));
+        const Interval tail = ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i);
+        if (!s.data.escape.present) return ir::series_combine(s.kind, acc, tail);
+        Interval state[8];
+        const int dims = load_state(s, state);
+        return ir::lipschitz_finish(s.kind, s.data.escape, acc, tail,
+                                    ir::escape_bound_around(s.kind, s.data.escape, state, dims, i + 1, h), i,
+                                    h);
     }
 
-    // The tail after index i tightened by the series' escape certificate, from the orbit point q_{i+1}.
-    Interval escape_tail(const TapeSeries& s, Interval tail, std::int64_t i) const {
-        if (!s.data.escape.present) return tail;
-        Interval state[8];
+    int load_state(const TapeSeries& s, Interval* state) const {
         for (std::size_t c = 0; c < s.state_slots.size(); ++c) state[c] = boxes_[s.state_slots[c]];
-        return ir::escape_tighten(
-            s.kind, tail,
-            ir::escape_bound(s.kind, s.data.escape, state, static_cast<int>(s.state_slots.size()), i + 1));
+        return static_cast<int>(s.state_slots.size());
+    }
+    double centre_orbit(const TapeSeries& s) {
+        Interval state[8];
+        const int dims = load_state(s, state);
+        const double h = ir::lipschitz_centre(state, dims);
+        for (int c = 0; c < dims; ++c) boxes_[s.state_slots[static_cast<std::size_t>(c)]] = state[c];
+        return h;
     }
 
     double series_point(const TapeSeries& s) {

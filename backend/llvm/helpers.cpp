@@ -14,7 +14,8 @@ namespace {
 CInterval out(num::Interval v) { return {v.lo, v.hi}; }
 // The certificate of ir::OrbitEscape from the helpers' arguments.
 frac::ir::OrbitEscape escape_of(double radius, double slope, double offset, double scale0_lo,
-                                double scale0_hi, double growth_lo, double growth_hi) {
+                                double scale0_hi, double growth_lo, double growth_hi, double lipschitz = 0.0,
+                                double map_lipschitz = 0.0) {
     frac::ir::OrbitEscape e;
     e.present = true;
     e.radius = radius;
@@ -22,6 +23,8 @@ frac::ir::OrbitEscape escape_of(double radius, double slope, double offset, doub
     e.offset = offset;
     e.scale0 = {scale0_lo, scale0_hi};
     e.growth = {growth_lo, growth_hi};
+    e.lipschitz = lipschitz;
+    e.map_lipschitz = map_lipschitz;
     return e;
 }
 } // namespace
@@ -75,18 +78,51 @@ void frac_jit_vtail(int kind, const double* in, const std::int64_t* n, double* o
 
 void frac_jit_vescape(int kind, const double* in, const std::int64_t* n, double* out, int dims, double radius,
                       double slope, double offset, double scale0_lo, double scale0_hi, double growth_lo,
-                      double growth_hi, std::uint32_t mask, int lanes) noexcept {
+                      double growth_hi, double lipschitz, double map_lipschitz, const double* h,
+                      std::uint32_t mask, int lanes) noexcept {
     const auto o = static_cast<frac::ir::Op>(kind);
-    const frac::ir::OrbitEscape e =
-        escape_of(radius, slope, offset, scale0_lo, scale0_hi, growth_lo, growth_hi);
+    const frac::ir::OrbitEscape e = escape_of(radius, slope, offset, scale0_lo, scale0_hi, growth_lo,
+                                              growth_hi, lipschitz, map_lipschitz);
     num::Interval state[8];
     for (int l = 0; l < lanes; ++l) {
         if (!(mask >> l & 1)) {
-            out[l] = o == frac::ir::Op::SeriesMax ? num::inf : -num::inf;
+            out[l] = out[lanes + l] = o == frac::ir::Op::SeriesMax ? num::inf : -num::inf;
             continue;
         }
         for (int c = 0; c < dims; ++c) state[c] = {in[2 * c * lanes + l], in[(2 * c + 1) * lanes + l]};
         out[l] = frac::ir::escape_bound(o, e, state, dims, n[l]);
+        out[lanes + l] = frac::ir::escape_bound_around(o, e, state, dims, n[l], h ? h[l] : 0.0);
+    }
+}
+
+void frac_jit_vcentre(double* in, int dims, double* h, std::uint32_t mask, int lanes) noexcept {
+    num::Interval state[8];
+    for (int l = 0; l < lanes; ++l) {
+        h[l] = 0.0;
+        if (!(mask >> l & 1)) continue;
+        for (int c = 0; c < dims; ++c) state[c] = {in[2 * c * lanes + l], in[(2 * c + 1) * lanes + l]};
+        h[l] = frac::ir::lipschitz_centre(state, dims);
+        for (int c = 0; c < dims; ++c) {
+            in[2 * c * lanes + l] = state[c].lo;
+            in[(2 * c + 1) * lanes + l] = state[c].hi;
+        }
+    }
+}
+
+void frac_jit_vfinish(int kind, double* io, const double* bound, const std::int64_t* n, const double* h,
+                      double radius, double slope, double offset, double scale0_lo, double scale0_hi,
+                      double growth_lo, double growth_hi, double lipschitz, double map_lipschitz,
+                      std::uint32_t mask, int lanes) noexcept {
+    const auto o = static_cast<frac::ir::Op>(kind);
+    const frac::ir::OrbitEscape e = escape_of(radius, slope, offset, scale0_lo, scale0_hi, growth_lo,
+                                              growth_hi, lipschitz, map_lipschitz);
+    for (int l = 0; l < lanes; ++l) {
+        num::Interval r(0.0);
+        if (mask >> l & 1)
+            r = frac::ir::lipschitz_finish(o, e, {io[l], io[lanes + l]},
+                                           {io[2 * lanes + l], io[3 * lanes + l]}, bound[l], n[l], h[l]);
+        io[l] = r.lo;
+        io[lanes + l] = r.hi;
     }
 }
 
@@ -154,6 +190,8 @@ const std::vector<Helper>& helpers() {
         FRAC_HELPER(frac_jit_vop),
         FRAC_HELPER(frac_jit_vtail),
         FRAC_HELPER(frac_jit_vescape),
+        FRAC_HELPER(frac_jit_vcentre),
+        FRAC_HELPER(frac_jit_vfinish),
         FRAC_HELPER(frac_jit_escape_point_done),
     };
 #undef FRAC_HELPER

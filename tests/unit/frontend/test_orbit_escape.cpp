@@ -9,6 +9,15 @@ using namespace frac::front;
 
 namespace {
 
+// The certificate of the series at the root of `shape`, which must have one.
+const ir::OrbitEscape& escape_of(const Compilation& c, const char* shape) {
+    const ShapeInfo* s = c.module.find_shape(shape);
+    REQUIRE(s);
+    const ir::OrbitEscape& e = c.module.graph[s->root].series.escape;
+    REQUIRE(e.present);
+    return e;
+}
+
 const ir::Node& root_of(const Compilation& c, const char* shape) {
     const ShapeInfo* s = c.module.find_shape(shape);
     REQUIRE(s);
@@ -41,6 +50,22 @@ TEST_CASE("the Koch map: |M(q)| >= 3|q| - 1 gives the escape radius 1/2", "[esca
     CHECK(e.offset == 0.0); // 1/2 - 0.25 > 0
     CHECK(e.growth == ir::Interval(3.0));
     CHECK(e.scale0 == ir::Interval(1.0));
+    // The fold is 1-Lipschitz (|g'| = 1 up to the rounding of pi / 3 and 3 / pi), so M is 3-Lipschitz
+    // and every term 1-Lipschitz in the initial point.
+    CHECK(e.lipschitz == 1.0);
+    CHECK(e.map_lipschitz >= 3.0);
+    CHECK(e.map_lipschitz <= 3.0 * (1 + 1e-14));
+}
+
+TEST_CASE("no Lipschitz bound without a continuous fold", "[escape]") {
+    // atan2(p.y, p.x) jumps across the negative x axis: the certificate holds, the Lipschitz bound is not
+    // claimed.
+    auto c = compile_source("t.frac", "fn m(p) = let r = sqrt(p.x^2 + p.y^2), f = atan2(p.y, p.x) / 2 in "
+                                      "(3 * r * cos(f) - 1, 3 * r * sin(f));\n"
+                                      "shape s(x, y) = min(k in 0.., p in orbit((x, y), m) escape 1/2, "
+                                      "(sqrt(p.x^2 + p.y^2) - 0.25) / 3^k);");
+    REQUIRE(c->ok());
+    CHECK(escape_of(*c, "s").lipschitz == 0.0);
 }
 
 TEST_CASE("escape bounds: a box outside the ball bounds every later term", "[escape]") {
@@ -73,12 +98,12 @@ TEST_CASE("signed permutations in 3D and max series are certified", "[escape]") 
         "shape t(x, y) = max(k in 0.., p in orbit((x, y, 0), m) escape 1/2, 2 * (0.1 - sqrt(p.x^2 + p.y^2 + "
         "p.z^2)) * 3^(-k));");
     REQUIRE(c->ok());
-    const ir::OrbitEscape& s = root_of(*c, "s").series.escape;
-    REQUIRE(s.present);
+    const ir::OrbitEscape& s = escape_of(*c, "s");
     CHECK(s.offset < 0); // 0.6 - 1 < 0: the constant part of the bound is negative
     CHECK(s.offset >= -0.4 - 1e-15);
-    const ir::OrbitEscape& t = root_of(*c, "t").series.escape;
-    REQUIRE(t.present);
+    CHECK(s.lipschitz == 1.0); // a signed permutation with abs: M is 3-Lipschitz
+    CHECK(s.map_lipschitz == 3.0);
+    const ir::OrbitEscape& t = escape_of(*c, "t");
     CHECK(t.slope == 1.0); // -(0.1 - |q|) = |q| - 0.1, the factor 2 goes to the scale
     CHECK(t.scale0 == ir::Interval(2.0));
     CHECK(t.growth == ir::Interval(3.0));
