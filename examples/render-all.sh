@@ -23,7 +23,7 @@ render fig10_double_koch.frac double_flake 8
 render_as fig11_koch_levels.frac flake0 8 fig11_flake0
 render_as fig11_koch_levels.frac flake1 8 fig11_flake1
 render_as fig11_koch_levels.frac flake2 8 fig11_flake2
-render fig13_koch_polar.frac koch_flake 7
+render fig13_koch_polar.frac koch_flake 9
 render similitude_disks.frac turned_disks_direct 8
 render_as rough_terrain.frac terrain_profile 9 rough_terrain_profile
 "$frac" mesh "$here/rough_terrain.frac" terrain --depth 6 -o "$out/rough_terrain.stl"

@@ -22,7 +22,8 @@ enum class ExprKind {
     field,    // text: component name (x, y, z); kids[0]
     interval, // kids: lo, hi
     series,   // text: sum | min | max; var; kids: start, end (null if infinite), body,
-              // and for an orbit series (orbit_var in orbit(kids[3], orbit_map)) the initial point
+              // and for an orbit series (orbit_var in orbit(kids[3], orbit_map)) the initial point,
+              // then the escape radius kids[4] when there is one
     lambda,   // fn (a, b) = body, an argument: bindings: the parameters (values null); kids[0]: body
 };
 
@@ -47,7 +48,7 @@ struct Expr {
     std::string text;
     std::string var;                  // series index name
     std::string orbit_var, orbit_map; // orbit series: the point's name and the map (a function)
-    Location orbit_loc;
+    Location orbit_loc, escape_loc;
     Tok op = Tok::end; // unary / binary operator
     std::vector<ExprPtr> kids;
     std::vector<Arg> args;

@@ -1,6 +1,7 @@
 #include "frontend/elaborate.hpp"
 
 #include "frontend/builtins.hpp"
+#include "frontend/orbit_escape.hpp"
 #include "frontend/series_bounds.hpp"
 
 #include <cmath>
@@ -643,6 +644,31 @@ private:
         return r;
     }
 
+    // The radius of `escape R`: a positive constant, on an infinite min or max series.
+    NodeId escape_radius_of(const Expr& e, bool infinite) {
+        const Expr& r = *e.kids[4];
+        if (!infinite)
+            fail(e.escape_loc, "an escape certificate needs an infinite series (a finite one has no tail)");
+        if (e.text == "sum")
+            fail(e.escape_loc, "an escape certificate applies to min and max series, not to a sum");
+        const NodeId radius = scalar(expr(r), r.loc);
+        if (!g_.is_const(radius) || !(g_[radius].value.lo >= 0) || !std::isfinite(g_[radius].value.hi))
+            fail(r.loc, "the escape radius must be a finite constant >= 0");
+        return radius;
+    }
+    ir::OrbitEscape prove_escape(const Expr& e, Op kind, NodeId body, const std::vector<NodeId>& orbit,
+                                 const ir::SeriesData& data, NodeId radius) {
+        const std::vector<NodeId> map(orbit.begin() + data.state_count, orbit.end());
+        std::string why;
+        std::optional<ir::OrbitEscape> escape;
+        {
+            num::UpwardRounding up;
+            escape = prove_orbit_escape(g_, body, map, data.level, kind, g_[radius].value, why);
+        }
+        if (!escape) fail(e.escape_loc, "cannot prove this escape certificate: " + why);
+        return *escape;
+    }
+
     Value series(const Expr& e) {
         const std::size_t frame = frames_.size() - 1; // frames_ grows while the body is elaborated
         auto integer = [&](const Expr& x, const char* what) {
@@ -682,10 +708,12 @@ private:
             }
         } restore{frames_, frame};
         std::vector<NodeId> orbit; // initial point, then the map applied to the state
+        NodeId escape_radius = ir::no_node;
         if (!e.orbit_var.empty()) {
             // The initial point is outside the series (the index is not visible to it).
             frames_[frame].scopes.pop_back();
             const Value init = expr(*e.kids[3]);
+            if (e.kids.size() > 4) escape_radius = escape_radius_of(e, infinite);
             frames_[frame].scopes.emplace_back();
             frames_[frame].scopes.back().emplace_back(e.var, Value::scalar(g_.index(data.level)));
             if (init.kind != ValueKind::point)
@@ -726,6 +754,10 @@ private:
         }
         if (!bound) fail(e.loc, "cannot bound this infinite series: " + why);
         data.gamma = bound->gamma;
+        data.one_sided = kind == Op::SeriesMin ? !bound->no_upper.empty()
+                                               : kind == Op::SeriesMax && !bound->no_lower.empty();
+        if (escape_radius != ir::no_node)
+            data.escape = prove_escape(e, kind, body, orbit, data, escape_radius);
         return Value::scalar(g_.series(kind, data, body, bound->a, bound->b, orbit));
     }
 

@@ -411,9 +411,16 @@ private:
             expect(Tok::comma, "after the orbit's initial point");
             e->orbit_map = expect(Tok::ident, "(the map of the orbit)").text;
             expect(Tok::rparen, "to close the orbit");
+            // An escape certificate: `escape R`, a radius the compiler proves orbits never return from.
+            ExprPtr escape;
+            if (at(Tok::ident) && cur().text == "escape") {
+                e->escape_loc = take().loc;
+                escape = add_expr();
+            }
             expect(Tok::comma, "after the orbit");
             e->kids.push_back(expr());
             e->kids.push_back(std::move(init));
+            if (escape) e->kids.push_back(std::move(escape));
         } else {
             e->kids.push_back(expr());
         }

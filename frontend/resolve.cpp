@@ -201,6 +201,7 @@ private:
             if (e.kids[1]) expr(*e.kids[1]);
             if (!e.orbit_var.empty()) {
                 expr(*e.kids[3]);
+                if (e.kids.size() > 4) expr(*e.kids[4]);
                 auto m = globals_.find(e.orbit_map);
                 if (const std::optional<int> l = local(e.orbit_map)) {
                     if (*l == value)

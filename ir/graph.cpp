@@ -27,6 +27,14 @@ std::uint64_t bits(double v) {
     return std::bit_cast<std::uint64_t>(v);
 }
 
+bool same_escape(const OrbitEscape& a, const OrbitEscape& b) {
+    return a.present == b.present && bits(a.radius) == bits(b.radius) && bits(a.slope) == bits(b.slope) &&
+           bits(a.offset) == bits(b.offset) && bits(a.scale0.lo) == bits(b.scale0.lo) &&
+           bits(a.scale0.hi) == bits(b.scale0.hi) && bits(a.growth.lo) == bits(b.growth.lo) &&
+           bits(a.growth.hi) == bits(b.growth.hi) && bits(a.lipschitz) == bits(b.lipschitz) &&
+           bits(a.map_lipschitz) == bits(b.map_lipschitz);
+}
+
 void mix(std::size_t& h, std::uint64_t v) {
     h ^= std::hash<std::uint64_t>{}(v) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
 }
@@ -54,6 +62,7 @@ std::size_t Graph::KeyHash::operator()(const Node& n) const {
     mix(h, static_cast<std::uint64_t>(n.series.start));
     mix(h, static_cast<std::uint64_t>(n.series.end));
     for (NodeId o : n.orbit) mix(h, o);
+    mix(h, bits(n.series.escape.radius));
     return h;
 }
 
@@ -64,7 +73,8 @@ bool Graph::KeyEq::operator()(const Node& a, const Node& b) const {
            a.series.level == b.series.level && a.series.start == b.series.start &&
            a.series.end == b.series.end && bits(a.series.gamma.lo) == bits(b.series.gamma.lo) &&
            bits(a.series.gamma.hi) == bits(b.series.gamma.hi) &&
-           a.series.state_count == b.series.state_count && a.orbit == b.orbit;
+           a.series.state_count == b.series.state_count && a.orbit == b.orbit && a.series.one_sided == b.series.one_sided &&
+           same_escape(a.series.escape, b.series.escape);
 }
 
 NodeId Graph::intern(const Node& n) {

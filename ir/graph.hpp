@@ -38,12 +38,35 @@ inline constexpr std::int64_t infinite_end = std::numeric_limits<std::int64_t>::
 // with A and B enclosed by evaluating the nodes tail_a / tail_b over the current box (B may be absent)
 // and 0 < gamma < 1. A may be unbounded on one side: a min series needs only a lower bound of its
 // terms, a max series only an upper bound. The frontend proves this form (frontend/series_bounds).
+// An escape certificate of an orbit min (max) series, proven by the frontend (frontend/orbit_escape):
+// once the orbit point q_m lies outside the ball |q| <= radius (Euclidean norm), every later term t_j
+// (j >= m) of a min series satisfies t_j >= (slope (|q_m| - radius) + offset) * scale0 / growth^m; for a
+// max series -t_j does. slope >= 0 and offset <= 0 are lower bounds, radius an upper bound.
+struct OrbitEscape {
+    bool present = false;
+    double radius = 0.0;
+    double slope = 0.0;
+    double offset = 0.0;
+    Interval scale0{1.0, 1.0};
+    Interval growth{1.0, 1.0};
+    // When > 0: the term of index j is lipschitz * (map_lipschitz / growth)^j - Lipschitz in the orbit's
+    // initial point, and |M(q) - M(q')| <= map_lipschitz |q - q'| (Euclidean): a box may be evaluated
+    // at its centre and widened (ir::lipschitz_finish).
+    double lipschitz = 0.0;
+    double map_lipschitz = 0.0;
+    bool operator==(const OrbitEscape&) const = default;
+};
+
 struct SeriesData {
     int level = 0; // nesting level; the body reads the index with Index(level)
     std::int64_t start = 0;
     std::int64_t end = infinite_end; // inclusive; infinite_end for an infinite series
     Interval gamma{0.0, 0.0};        // decay, proven 0 < gamma.hi < 1 for infinite series
     int state_count = 0;             // orbit series: components of the orbit point
+    OrbitEscape escape;              // orbit series: optional escape certificate
+    // The term bound is one-sided (A infinite on one side): the tail says nothing about the value's
+    // other side, so point evaluation cannot estimate the tail from A's point value.
+    bool one_sided = false;
     bool operator==(const SeriesData&) const = default;
 };
 

@@ -1,5 +1,6 @@
 // Text form of the expression graph (frac check --emit=ir).
 #include "ir/graph.hpp"
+#include "ir/series_tail.hpp"
 
 #include <algorithm>
 #include <fmt/format.h>
@@ -55,6 +56,7 @@ std::string print_graph(const Graph& g, const std::vector<NodeId>& roots) {
                                        n.orbit[static_cast<std::size_t>(s.state_count + c)]);
                 }
                 out += fmt::format(" orbit from ({}) map ({})", from, map);
+                if (s.escape.present) out += escape_text(s.escape);
             }
             break;
         }

@@ -1,11 +1,17 @@
 #include "ir/series_tail.hpp"
 
 #include <cmath>
+#include <fmt/format.h>
+#include <limits>
 #include <stdexcept>
 
 namespace frac::ir {
 
 using namespace frac::num;
+
+namespace {
+constexpr double inf = std::numeric_limits<double>::infinity();
+}
 
 Interval series_term_bound(Interval a, Interval b, bool has_b, Interval gamma_i, std::int64_t i) {
     const Interval coeff = has_b ? add(a, mul(b, Interval(static_cast<double>(i)))) : a;
@@ -59,6 +65,101 @@ Interval series_tail(Op kind, Interval a, Interval b, bool has_b, Interval gamma
     default: break;
     }
     throw std::logic_error("series_tail: not a series op");
+}
+
+namespace {
+
+Interval norm_of(const Interval* state, int dims) {
+    Interval norm2(0.0);
+    for (int c = 0; c < dims; ++c) norm2 = add(norm2, sqr(state[c]));
+    return sqrt(norm2);
+}
+
+double escape_bound_of_norm(Op kind, const OrbitEscape& e, Interval norm, std::int64_t n) {
+    const double none = kind == Op::SeriesMax ? inf : -inf;
+    if (!(norm.lo > e.radius)) return none; // not provably outside the ball (NaN included)
+    // (slope (|q| - radius) + offset) * scale0 / growth^n, enclosed over the box; its lower end.
+    const Interval excess = add(mul(Interval(e.slope), sub(norm, Interval(e.radius))), Interval(e.offset));
+    const Interval bound = mul(excess, div(e.scale0, powi(e.growth, n)));
+    if (!(bound.lo > -inf)) return none;
+    return kind == Op::SeriesMax ? -bound.lo : bound.lo;
+}
+
+} // namespace
+
+double escape_bound(Op kind, const OrbitEscape& e, const Interval* state, int dims, std::int64_t n) {
+    return escape_bound_of_norm(kind, e, norm_of(state, dims), n);
+}
+
+bool escape_stalls(Op kind, double now, double prev, Interval acc) {
+    // "Worse" beyond rounding noise: by more than 2^-30 of the previous bound (upward rounding).
+    const double slack = 0x1p-30 * std::fabs(prev);
+    if (kind == Op::SeriesMax) return now < inf && (now <= acc.hi || now > prev + slack);
+    return now > -inf && (now >= acc.lo || now < prev - slack);
+}
+
+double lipschitz_centre(Interval* init, int dims) {
+    for (int c = 0; c < dims; ++c)
+        if (!(std::isfinite(init[c].lo) && std::isfinite(init[c].hi) && init[c].lo <= init[c].hi)) return 0.0;
+    Interval h2(0.0);
+    for (int c = 0; c < dims; ++c) {
+        const double m = midpoint(init[c]);
+        const Interval d = sub(init[c], Interval(m)); // [lo - m, hi - m], outward
+        h2 = add(h2, Interval(std::fmax(-d.lo, d.hi) * std::fmax(-d.lo, d.hi)));
+        init[c] = Interval(m);
+    }
+    return sqrt(h2).hi;
+}
+
+double escape_bound_around(Op kind, const OrbitEscape& e, const Interval* state, int dims, std::int64_t n,
+                           double h) {
+    const Interval norm = norm_of(state, dims);
+    if (h == 0) return escape_bound_of_norm(kind, e, norm, n);
+    // |q_n(p) - q_n(c)| <= map_lipschitz^n |p - c|
+    const double spread = mul(powi(Interval(e.map_lipschitz), n), Interval(h)).hi;
+    return escape_bound_of_norm(kind, e, sub(norm, Interval(0.0, spread)), n);
+}
+
+Interval lipschitz_finish(Op kind, const OrbitEscape& e, Interval acc, Interval tail, double bound,
+                          std::int64_t n, double h) {
+    if (h > 0) {
+        // Terms 0..n move by at most lipschitz (map_lipschitz / growth)^k h <= that at k = n (ratio >= 1).
+        const Interval ratio = div(Interval(e.map_lipschitz), Interval(e.growth.lo));
+        const Interval spread =
+            mul(mul(Interval(e.lipschitz), powi(Interval(std::fmax(1.0, ratio.hi)), n)), Interval(h));
+        acc = add(acc, Interval(-spread.hi, spread.hi));
+    }
+    return series_combine(kind, acc, escape_tighten(kind, tail, bound));
+}
+
+Interval escape_tighten(Op kind, Interval tail, double bound) {
+    if (kind == Op::SeriesMax) {
+        const double hi = bound < tail.hi ? bound : tail.hi;
+        return {hi < tail.lo ? hi : tail.lo, hi};
+    }
+    const double lo = bound > tail.lo ? bound : tail.lo;
+    return {lo, lo > tail.hi ? lo : tail.hi};
+}
+
+bool escape_point_done(Op kind, const OrbitEscape& e, double acc, const double* state, int dims,
+                       std::int64_t n) {
+    double norm2 = 0.0;
+    for (int c = 0; c < dims; ++c) norm2 += state[c] * state[c];
+    const double norm = std::sqrt(norm2);
+    if (!(norm > e.radius)) return false;
+    const double bound = (e.slope * (norm - e.radius) + e.offset) *
+                         (e.scale0.lo / std::pow(e.growth.lo, static_cast<double>(n)));
+    const double slack = 0x1p-54 * std::fabs(acc);
+    return kind == Op::SeriesMax ? -bound <= acc + slack : bound >= acc - slack;
+}
+
+std::string escape_text(const OrbitEscape& e) {
+    std::string s =
+        fmt::format(" escape |q| > {}: terms >= ({} (|q| - {}) + {}) * [{}, {}] / [{}, {}]^i", e.radius,
+                    e.slope, e.radius, e.offset, e.scale0.lo, e.scale0.hi, e.growth.lo, e.growth.hi);
+    if (e.lipschitz > 0)
+        s += fmt::format(", term i {}-Lipschitz * ({} / growth)^i", e.lipschitz, e.map_lipschitz);
+    return s;
 }
 
 Interval series_combine(Op kind, Interval acc, Interval term) {

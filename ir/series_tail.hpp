@@ -5,6 +5,8 @@
 
 #include "ir/graph.hpp"
 
+#include <string>
+
 namespace frac::ir {
 
 // Enclosure of the tail: for a sum, of sum_{i>n} t_i; for a min (max), of inf (sup) over i>n of t_i,
@@ -13,6 +15,36 @@ Interval series_tail(Op kind, Interval a, Interval b, bool has_b, Interval gamma
 
 // Enclosure of the bound of the single term i: (A + B i) gamma^i, with gamma_i = gamma^i given.
 Interval series_term_bound(Interval a, Interval b, bool has_b, Interval gamma_i, std::int64_t i);
+
+// Escape certificates of orbit series (ir::OrbitEscape). `escape_bound` is the bound of every term
+// after index n - 1 given the orbit point q_n (`state`, `dims` components, as a box): a lower bound for
+// a min series, an upper bound for a max series; -inf (+inf) when the box does not lie outside the
+// escape ball. `escape_tighten` intersects a tail enclosure with it; every engine uses these two.
+double escape_bound(Op kind, const OrbitEscape& e, const Interval* state, int dims, std::int64_t n);
+Interval escape_tighten(Op kind, Interval tail, double bound);
+std::string escape_text(const OrbitEscape& e); // for the printers
+
+// Lipschitz enclosures (OrbitEscape::lipschitz > 0). `lipschitz_centre` replaces the initial point's
+// box by its centre (thin) and returns the radius h of the box around it (rounded up); with an
+// unbounded or empty component it leaves the box and returns 0. The series then runs on the centre;
+// `escape_bound_around` is escape_bound for every orbit point within map_lipschitz^n h of `state`,
+// and `lipschitz_finish` turns the centre's partial result `acc` (terms up to index n) and its tail
+// bounds into an enclosure over the whole box. With h = 0 both reduce to the plain forms.
+double lipschitz_centre(Interval* init, int dims);
+// A stopping rule of series with an escape certificate: stop when the bound from the orbit box, `now`,
+// reaches the partial result's bound or gets worse than the previous one (`prev`): from there on the
+// orbit box only widens (the wrapping of boxes through rotations) and later terms lose more than they
+// add.
+bool escape_stalls(Op kind, double now, double prev, Interval acc);
+double escape_bound_around(Op kind, const OrbitEscape& e, const Interval* state, int dims, std::int64_t n,
+                           double h);
+Interval lipschitz_finish(Op kind, const OrbitEscape& e, Interval acc, Interval tail, double bound,
+                          std::int64_t n, double h);
+// Point evaluation (round to nearest, no enclosure): true when the terms after index n - 1, bounded by
+// the certificate from the orbit point q_n, cannot move the partial result `acc` by more than its
+// last bit; the point value is then `acc`.
+bool escape_point_done(Op kind, const OrbitEscape& e, double acc, const double* state, int dims,
+                       std::int64_t n);
 
 // Combines a partial result with one more term (or with a tail).
 Interval series_combine(Op kind, Interval acc, Interval term);

@@ -1,4 +1,5 @@
 #include "ir/tape.hpp"
+#include "ir/series_tail.hpp"
 
 #include <bit>
 #include <fmt/format.h>
@@ -167,6 +168,7 @@ void print_block(const Tape& t, std::uint32_t b, int indent, std::string& out) {
             if (s.data.end == infinite_end)
                 out += fmt::format(" tail ({} + {} i) * {}^i", slot_name(s.tail_a), slot_name(s.tail_b),
                                    interval_text(s.data.gamma));
+            if (s.data.escape.present) out += escape_text(s.data.escape);
             out += "\n";
             continue;
         }

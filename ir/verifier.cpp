@@ -28,6 +28,11 @@ std::string verify_graph(const Graph& g) {
             const SeriesData& s = n.series;
             if (s.level < 1) return fmt::format("%{}: series without level", id);
             if (s.end != infinite_end && s.end < s.start) return fmt::format("%{}: empty series range", id);
+            if (s.escape.present &&
+                (s.state_count == 0 || s.end != infinite_end || n.op == Op::SeriesSum ||
+                 !(s.escape.slope >= 0) || !(s.escape.offset <= 0) || !(s.escape.radius >= 0) ||
+                 !(s.escape.growth.lo >= 1) || !(s.escape.scale0.lo > 0)))
+                return fmt::format("%{}: malformed escape certificate", id);
             if (s.end == infinite_end) {
                 if (n.args[1] == no_node) return fmt::format("%{}: infinite series without tail", id);
                 if (!(s.gamma.lo > 0 && s.gamma.hi < 1)) return fmt::format("%{}: decay not in (0, 1)", id);

@@ -24,6 +24,15 @@ struct DimensionEstimate {
     std::vector<std::pair<int, std::uint64_t>> counts;
 };
 
+// A lower bound of the same counts: the cells of level k, k < depth, that contain both a cell proven
+// inside and a cell proven outside (at some finer level). Such a cell provably meets the boundary
+// (f changes sign on it), so these counts never exceed the true N_k, while the undecided counts never
+// fall below it. Interval overestimation that grows with the depth (the wrapping of an orbit box
+// through a rotation, for instance) thickens the undecided band and biases the first estimate up;
+// this one only loses cells that touch the boundary too little to hold a proven cell of each kind.
+// Needs a result with keep_cells. Same fit, same exceptions as box_counting.
+DimensionEstimate box_counting_proven(const RssResult& r, int from_level, int to_level);
+
 // Fits the levels from_level..to_level (inclusive). Throws std::invalid_argument unless
 // 0 <= from_level < to_level <= depth, or when some N_k in the range is 0 (no boundary left).
 DimensionEstimate box_counting(const RssResult& r, int from_level, int to_level);

@@ -156,6 +156,10 @@ private:
         bool resolved = !infinite;
         for (std::size_t c = 0; c < s.state_slots.size(); ++c)
             boxes_[s.state_slots[c]] = boxes_[s.init_slots[c]];
+        // A proven Lipschitz bound: run the orbit from the centre of the initial box, widen at the end.
+        const double h = infinite && s.data.escape.lipschitz > 0 ? centre_orbit(s) : 0.0;
+        const bool escape = infinite && s.data.escape.present;
+        double escape_prev = s.kind == Op::SeriesMax ? num::inf : -num::inf;
         for (;; ++i) {
             boxes_[s.index_slot] = Interval(static_cast<double>(i));
             run_boxes(s.block);
@@ -172,7 +176,14 @@ private:
                     resolved = true;
                     break;
                 }
-                const Interval tail = ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i);
+                Interval tail = ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i);
+                double escape_now = 0.0;
+                if (escape) {
+                    Interval state[8];
+                    const int dims = load_state(s, state);
+                    escape_now = ir::escape_bound(s.kind, s.data.escape, state, dims, i + 1);
+                    tail = ir::escape_tighten(s.kind, tail, escape_now);
+                }
                 if (num::width(tail) <= 0x1p-52 * num::magnitude(acc) || num::width(tail) == 0) {
                     resolved = true;
                     break;
@@ -183,12 +194,35 @@ private:
                     resolved = true;
                     break;
                 }
+                if (escape && ir::escape_stalls(s.kind, escape_now, escape_prev, acc)) {
+                    resolved = true;
+                    break;
+                }
+                escape_prev = escape_now;
                 gamma_i = num::mul(gamma_i, s.data.gamma);
             }
         }
         if (!infinite) return acc;
         if (!resolved) ++stats.series_capped;
-        return ir::series_combine(s.kind, acc, ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i));
+        const Interval tail = ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i);
+        if (!s.data.escape.present) return ir::series_combine(s.kind, acc, tail);
+        Interval state[8];
+        const int dims = load_state(s, state);
+        return ir::lipschitz_finish(s.kind, s.data.escape, acc, tail,
+                                    ir::escape_bound_around(s.kind, s.data.escape, state, dims, i + 1, h), i,
+                                    h);
+    }
+
+    int load_state(const TapeSeries& s, Interval* state) const {
+        for (std::size_t c = 0; c < s.state_slots.size(); ++c) state[c] = boxes_[s.state_slots[c]];
+        return static_cast<int>(s.state_slots.size());
+    }
+    double centre_orbit(const TapeSeries& s) {
+        Interval state[8];
+        const int dims = load_state(s, state);
+        const double h = ir::lipschitz_centre(state, dims);
+        for (int c = 0; c < dims; ++c) boxes_[s.state_slots[static_cast<std::size_t>(c)]] = state[c];
+        return h;
     }
 
     double series_point(const TapeSeries& s) {
@@ -212,7 +246,16 @@ private:
             acc = i == s.data.start ? term : ir::series_combine_point(s.kind, acc, term);
             ++stats.series_terms;
             if (i == last) break;
-            if (infinite) {
+            if (infinite && s.data.escape.present) {
+                // The escape certificate bounds every later term from the orbit point q_{i+1}.
+                double state[8];
+                for (std::size_t c = 0; c < s.state_slots.size(); ++c) state[c] = points_[s.state_slots[c]];
+                if (ir::escape_point_done(s.kind, s.data.escape, acc, state,
+                                          static_cast<int>(s.state_slots.size()), i + 1)) {
+                    resolved = true;
+                    break;
+                }
+            } else if (infinite && !s.data.one_sided) {
                 // Estimate of the tail's size: stop once it is below half an ulp of the sum.
                 const double n1 = static_cast<double>(i + 1);
                 const double tail = (a + b * n1) * gamma_next * (n1 + 1.0) / ((1.0 - gamma) * (1.0 - gamma));
@@ -225,6 +268,7 @@ private:
         }
         if (!infinite) return acc;
         if (!resolved) ++stats.series_capped;
+        if (s.data.escape.present || s.data.one_sided) return acc; // no tail estimate from a one-sided bound
         Interval tail;
         {
             num::UpwardRounding up;

@@ -27,10 +27,12 @@
 #include <llvm/IR/IntrinsicsX86.h>
 #include <llvm/IR/Module.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <stdexcept>
+#include <tuple>
 
 namespace frac::jit {
 namespace {
@@ -107,18 +109,26 @@ public:
         capped_ = b_.CreateAlloca(i64_, nullptr, "capped");
         b_.CreateStore(b_.getInt64(0), terms_);
         b_.CreateStore(b_.getInt64(0), capped_);
+        // Scratch memory of the helpers, aligned for whole-vector loads and stores.
+        auto aligned = [&](Type* t, const char* what) {
+            llvm::AllocaInst* a = b_.CreateAlloca(t, nullptr, what);
+            a->setAlignment(llvm::Align(64));
+            return a;
+        };
         if (w_ > 1) {
-            // Scratch memory of the vector helpers: up to three interval operands in, one out.
-            // Aligned for whole-vector loads and stores.
-            auto aligned = [&](Type* t, const char* what) {
-                llvm::AllocaInst* a = b_.CreateAlloca(t, nullptr, what);
-                a->setAlignment(llvm::Align(64));
-                return a;
-            };
+            // The vector helpers: up to three interval operands in, one out.
             scratch_in_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(6 * w_)), "vin");
             scratch_n_ = aligned(llvm::ArrayType::get(i64_, static_cast<std::uint64_t>(w_)), "vn");
             scratch_out_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(2 * w_)), "vout");
             sink_ = aligned(llvm::ArrayType::get(dbl_, 2), "sink");
+        }
+        if (std::any_of(t_.series.begin(), t_.series.end(),
+                        [](const TapeSeries& s) { return s.data.escape.present; })) {
+            // The escape helper: up to 8 orbit components in, one bound per lane out.
+            esc_in_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(16 * w_)), "ein");
+            esc_n_ = aligned(llvm::ArrayType::get(i64_, static_cast<std::uint64_t>(w_)), "en");
+            esc_out_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(4 * w_)), "eout");
+            esc_h_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(w_)), "eh");
         }
         b_.CreateCondBr(b_.CreateICmpEQ(n, b_.getInt64(0)), done, loop);
 
@@ -750,6 +760,99 @@ private:
                       true);
     }
 
+    void store_state(const std::vector<IV>& state) {
+        const auto w = static_cast<std::uint64_t>(w_);
+        for (std::size_t c = 0; c < state.size(); ++c) {
+            b_.CreateStore(state[c].lo, b_.CreateConstInBoundsGEP1_64(dbl_, esc_in_, 2 * c * w));
+            b_.CreateStore(state[c].hi, b_.CreateConstInBoundsGEP1_64(dbl_, esc_in_, (2 * c + 1) * w));
+        }
+    }
+    std::vector<Value*> escape_params(const ir::OrbitEscape& e) {
+        auto d = [&](double x) { return llvm::ConstantFP::get(dbl_, x); };
+        return {d(e.radius),    d(e.slope),     d(e.offset),    d(e.scale0.lo),    d(e.scale0.hi),
+                d(e.growth.lo), d(e.growth.hi), d(e.lipschitz), d(e.map_lipschitz)};
+    }
+    Value* mask_arg(Value* mask) { return w_ == 1 ? b_.getInt32(1) : mask_bits(mask); }
+
+    // ir::lipschitz_centre of the initial point, lane by lane: the centres (replacing `init`) and h.
+    Value* centre_orbit(std::vector<IV>& init, Value* mask) {
+        store_state(init);
+        auto callee = m_.getOrInsertFunction(
+            "frac_jit_vcentre",
+            llvm::FunctionType::get(Type::getVoidTy(ctx_), {ptr_, i32_, ptr_, i32_, i32_}, false));
+        llvm::cast<Function>(callee.getCallee())->setDoesNotThrow();
+        b_.CreateCall(callee, {esc_in_, b_.getInt32(static_cast<std::uint32_t>(init.size())), esc_h_,
+                               mask_arg(mask), b_.getInt32(static_cast<std::uint32_t>(w_))});
+        const auto w = static_cast<std::uint64_t>(w_);
+        for (std::size_t c = 0; c < init.size(); ++c)
+            init[c] = {b_.CreateLoad(vt_, b_.CreateConstInBoundsGEP1_64(dbl_, esc_in_, 2 * c * w)),
+                       b_.CreateLoad(vt_, b_.CreateConstInBoundsGEP1_64(dbl_, esc_in_, (2 * c + 1) * w))};
+        return b_.CreateLoad(vt_, esc_h_);
+    }
+
+    // ir::lipschitz_finish lane by lane.
+    SlotState lipschitz_finish(const TapeSeries& s, const SlotState& acc, const SlotState& tail, Value* bound,
+                               Value* n, Value* mask) {
+        const auto w = static_cast<std::uint64_t>(w_);
+        b_.CreateStore(acc.v.lo, b_.CreateConstInBoundsGEP1_64(dbl_, esc_out_, 0));
+        b_.CreateStore(acc.v.hi, b_.CreateConstInBoundsGEP1_64(dbl_, esc_out_, w));
+        b_.CreateStore(tail.v.lo, b_.CreateConstInBoundsGEP1_64(dbl_, esc_out_, 2 * w));
+        b_.CreateStore(tail.v.hi, b_.CreateConstInBoundsGEP1_64(dbl_, esc_out_, 3 * w));
+        b_.CreateStore(bound, esc_in_);
+        b_.CreateStore(n->getType()->isVectorTy() ? n : splat(n), esc_n_);
+        std::vector<Type*> types = {i32_, ptr_, ptr_, ptr_, ptr_};
+        for (int k = 0; k < 9; ++k) types.push_back(dbl_);
+        types.push_back(i32_);
+        types.push_back(i32_);
+        auto callee = m_.getOrInsertFunction("frac_jit_vfinish",
+                                             llvm::FunctionType::get(Type::getVoidTy(ctx_), types, false));
+        llvm::cast<Function>(callee.getCallee())->setDoesNotThrow();
+        std::vector<Value*> args = {b_.getInt32(static_cast<std::uint32_t>(s.kind)), esc_out_, esc_in_,
+                                    esc_n_, esc_h_};
+        for (Value* p : escape_params(s.data.escape)) args.push_back(p);
+        args.push_back(mask_arg(mask));
+        args.push_back(b_.getInt32(static_cast<std::uint32_t>(w_)));
+        b_.CreateCall(callee, args);
+        return result({b_.CreateLoad(vt_, esc_out_),
+                       b_.CreateLoad(vt_, b_.CreateConstInBoundsGEP1_64(dbl_, esc_out_, w))},
+                      true);
+    }
+
+    // ir::escape_bound of the orbit point `state` (index n, scalar) for the lanes in `mask`, and
+    // ir::escape_bound_around with each lane's radius h (the same without a Lipschitz bound).
+    std::pair<Value*, Value*> escape_bound(const TapeSeries& s, const std::vector<IV>& state, Value* n,
+                                           Value* mask) {
+        const auto w = static_cast<std::uint64_t>(w_);
+        store_state(state);
+        b_.CreateStore(splat(n), esc_n_);
+        auto callee = m_.getOrInsertFunction(
+            "frac_jit_vescape", llvm::FunctionType::get(Type::getVoidTy(ctx_),
+                                                        {i32_, ptr_, ptr_, ptr_, i32_, dbl_, dbl_, dbl_, dbl_,
+                                                         dbl_, dbl_, dbl_, dbl_, dbl_, ptr_, i32_, i32_},
+                                                        false));
+        llvm::cast<Function>(callee.getCallee())->setDoesNotThrow();
+        std::vector<Value*> args = {b_.getInt32(static_cast<std::uint32_t>(s.kind)), esc_in_, esc_n_,
+                                    esc_out_, b_.getInt32(static_cast<std::uint32_t>(state.size()))};
+        for (Value* p : escape_params(s.data.escape)) args.push_back(p);
+        args.push_back(s.data.escape.lipschitz > 0
+                           ? esc_h_
+                           : llvm::ConstantPointerNull::get(llvm::PointerType::get(ctx_, 0)));
+        args.push_back(mask_arg(mask));
+        args.push_back(b_.getInt32(static_cast<std::uint32_t>(w_)));
+        b_.CreateCall(callee, args);
+        return {b_.CreateLoad(vt_, esc_out_),
+                b_.CreateLoad(vt_, b_.CreateConstInBoundsGEP1_64(dbl_, esc_out_, w))};
+    }
+    // ir::escape_tighten: the tail intersected with the escape bound; its signs are no longer known.
+    SlotState escape_tighten(Op kind, const SlotState& tail, Value* bound) {
+        if (kind == Op::SeriesMax) {
+            Value* hi = sel(lt(bound, tail.v.hi), bound, tail.v.hi);
+            return result({sel(lt(hi, tail.v.lo), hi, tail.v.lo), hi}, true);
+        }
+        Value* lo = sel(gt(bound, tail.v.lo), bound, tail.v.lo);
+        return result({lo, sel(gt(lo, tail.v.hi), lo, tail.v.hi)}, true);
+    }
+
     SlotState emit_series(const Instr& ins) {
         const TapeSeries& s = t_.series[ins.series];
         const SeriesTables& st = tab_.series[ins.series];
@@ -762,6 +865,11 @@ private:
         Value* outer_mask = ctx_mask_;
         Value* start_v = b_.getInt64(static_cast<std::uint64_t>(start));
 
+        // A proven Lipschitz bound: the orbit runs from the centre of the initial box (ir::lipschitz_centre).
+        std::vector<IV> init;
+        for (std::size_t c = 0; c < s.state_slots.size(); ++c) init.push_back(states_[s.init_slots[c]].v);
+        const bool lipschitz = infinite && s.data.escape.present && s.data.escape.lipschitz > 0;
+        if (lipschitz) centre_orbit(init, outer_mask);
         BasicBlock* pre = b_.GetInsertBlock();
         BasicBlock* header = BasicBlock::Create(ctx_, "series", fn_);
         BasicBlock* exit = BasicBlock::Create(ctx_, "series.exit", fn_);
@@ -781,14 +889,24 @@ private:
         for (std::size_t c = 0; c < s.state_slots.size(); ++c) {
             llvm::PHINode* lo = b_.CreatePHI(vt_, 2, "state.lo");
             llvm::PHINode* hi = b_.CreatePHI(vt_, 2, "state.hi");
-            const SlotState& init = states_[s.init_slots[c]];
-            lo->addIncoming(init.v.lo, pre);
-            hi->addIncoming(init.v.hi, pre);
+            lo->addIncoming(init[c].lo, pre);
+            hi->addIncoming(init[c].hi, pre);
             state_phis.emplace_back(lo, hi);
             SlotState sc;
             sc.v = {lo, hi};
             sc.f = tab_.slot_facts[s.state_slots[c]];
             states_[s.state_slots[c]] = sc;
+        }
+        const bool escape = infinite && s.data.escape.present;
+        // Escape certificate: each lane's bound (around the centre) where it stopped, and the previous
+        // term's bound of the orbit box (for the stalling rule).
+        llvm::PHINode* esc_frozen = nullptr;
+        llvm::PHINode* esc_prev = nullptr;
+        if (escape) {
+            esc_frozen = b_.CreatePHI(vt_, 2, "esc.frozen");
+            esc_frozen->addIncoming(cst(s.kind == Op::SeriesMax ? inf : -inf), pre);
+            esc_prev = b_.CreatePHI(vt_, 2, "esc.prev");
+            esc_prev->addIncoming(cst(s.kind == Op::SeriesMax ? inf : -inf), pre);
         }
         Value* idx = b_.CreateSub(i, start_v, "idx");
         idx_[ins.series] = idx;
@@ -802,6 +920,11 @@ private:
         std::vector<IV> next_state;
         for (std::size_t c = 0; c < s.state_slots.size(); ++c) next_state.push_back(states_[s.update_slots[c]].v);
         const SlotState term = states_[s.body_slot];
+        // Escape certificate: the bound of the terms after i from the next orbit point.
+        Value* esc_now = nullptr; // the bound from the orbit box
+        Value* esc_far = nullptr; // the same for every orbit within the Lipschitz spread of it
+        if (escape)
+            std::tie(esc_now, esc_far) = escape_bound(s, next_state, b_.CreateAdd(i, b_.getInt64(1)), active);
         const SlotState acc = result({acc_lo, acc_hi}, term.f.maybe_empty);
         const SlotState comb = combine(s.kind, acc, term);
         Value* first = splat(b_.CreateICmpEQ(i, start_v));
@@ -813,6 +936,8 @@ private:
         // At the last index every active lane stops, capped by the term limit (infinite series).
         Value* splat_i = w_ == 1 ? static_cast<Value*>(i) : b_.CreateVectorSplat(static_cast<unsigned>(w_), i);
         Value* last_at = w_ == 1 ? static_cast<Value*>(i) : b_.CreateSelect(active, splat_i, stop_at);
+        Value* esc_last = escape ? (w_ == 1 ? esc_far : sel(active, esc_far, esc_frozen)) : nullptr;
+        Value* esc_next = esc_frozen;
         BasicBlock* from_last = b_.GetInsertBlock();
         BasicBlock* latch = BasicBlock::Create(ctx_, "series.next", fn_);
         Value* still = active;        // lanes that go on to the next term
@@ -858,6 +983,10 @@ private:
                 tail = tail_core(s, a, bc, has_b, i, rest);
                 tail_width = width(tail);
             }
+            if (escape) {
+                tail = escape_tighten(s.kind, tail, esc_now);
+                tail_width = width(tail);
+            }
             Value* small = b_.CreateOr(le(tail_width, mul(cst(0x1p-52), magnitude(nacc))), eq(tail_width, cst(0.0)));
             if (s.kind == Op::SeriesMin) {
                 Value* one_sided = eq(fabs(tail.v.hi), cst(inf));
@@ -868,6 +997,16 @@ private:
                 Value* no_gain = land(le(tail.v.hi, nacc.v.hi), le(term.v.lo, nacc.v.lo));
                 small = b_.CreateOr(small, land(one_sided, no_gain));
             }
+            if (escape) {
+                // ir::escape_stalls
+                Value* slack = mul(cst(0x1p-30), fabs(esc_prev));
+                Value* stalls = s.kind == Op::SeriesMax
+                                    ? land(lt(esc_now, cst(inf)),
+                                           lor(le(esc_now, nacc.v.hi), gt(esc_now, add(esc_prev, slack))))
+                                    : land(gt(esc_now, cst(-inf)),
+                                           lor(ge(esc_now, nacc.v.lo), lt(esc_now, sub(esc_prev, slack))));
+                small = b_.CreateOr(small, stalls);
+            }
             Value* stop2 = b_.CreateOr(stop1, land(rest, small));
             BasicBlock* check2_end = b_.GetInsertBlock();
             b_.CreateBr(decide);
@@ -877,6 +1016,7 @@ private:
             stop->addIncoming(stop2, check2_end);
             still = land(active, lnot(stop));
             stop_at_next = b_.CreateSelect(stop, splat_i, stop_at);
+            if (escape) esc_next = sel(stop, esc_far, esc_frozen);
             decided = b_.GetInsertBlock();
             b_.CreateCondBr(any(still), latch, exit);
         }
@@ -888,6 +1028,10 @@ private:
         acc_hi->addIncoming(nacc.v.hi, latch);
         active->addIncoming(still, latch);
         stop_at->addIncoming(stop_at_next, latch);
+        if (escape) {
+            esc_frozen->addIncoming(esc_next, latch);
+            esc_prev->addIncoming(esc_now, latch);
+        }
         for (std::size_t c = 0; c < state_phis.size(); ++c) {
             state_phis[c].first->addIncoming(next_state[c].lo, latch);
             state_phis[c].second->addIncoming(next_state[c].hi, latch);
@@ -903,6 +1047,12 @@ private:
         final_at->addIncoming(last_at, from_last);
         capped_lanes->addIncoming(i1(false), decided);
         final_at->addIncoming(stop_at_next, decided);
+        llvm::PHINode* esc_final = nullptr;
+        if (escape) {
+            esc_final = b_.CreatePHI(vt_, 2, "esc.final");
+            esc_final->addIncoming(esc_last, from_last);
+            esc_final->addIncoming(esc_next, decided);
+        }
         bump(capped_, count(capped_lanes));
         Value* final_idx = b_.CreateSub(final_at, w_ == 1 ? start_v : b_.CreateVectorSplat(static_cast<unsigned>(w_), start_v));
         SlotState tail;
@@ -910,6 +1060,8 @@ private:
             tail = from_table(gather_pair(table(&st.tail, st.tail, "tail"), final_idx), facts_of(st.tail.data(), st.tail.size()));
         else
             tail = tail_core(s, a, bc, has_b, final_at, outer_mask);
+        if (lipschitz) return lipschitz_finish(s, nacc, tail, esc_final, final_at, outer_mask);
+        if (escape) tail = escape_tighten(s.kind, tail, esc_final);
         return combine(s.kind, nacc, tail);
     }
 
@@ -948,6 +1100,10 @@ private:
     Value* scratch_in_ = nullptr;
     Value* scratch_n_ = nullptr;
     Value* scratch_out_ = nullptr;
+    Value* esc_in_ = nullptr; // escape helper scratch (series with an escape certificate only)
+    Value* esc_n_ = nullptr;
+    Value* esc_out_ = nullptr;
+    Value* esc_h_ = nullptr;
     Value* sink_ = nullptr;
     Value* ctx_mask_ = nullptr; // lanes the current code computes for
     std::vector<SlotState> states_;

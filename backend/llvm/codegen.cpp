@@ -119,6 +119,7 @@ public:
         capped_ = b_.CreateAlloca(i64_, nullptr, "capped");
         b_.CreateStore(b_.getInt64(0), terms_);
         b_.CreateStore(b_.getInt64(0), capped_);
+        escape_state_ = b_.CreateAlloca(llvm::ArrayType::get(dbl_, 8), nullptr, "escape.state");
         b_.CreateCondBr(b_.CreateICmpEQ(n, b_.getInt64(0)), done, loop);
         b_.SetInsertPoint(loop);
         llvm::PHINode* k = b_.CreatePHI(i64_, 2, "k");
@@ -269,8 +270,25 @@ private:
         bump(terms_, b_.getInt64(1));
         Value* is_last = b_.CreateICmpEQ(i, b_.getInt64(static_cast<std::uint64_t>(last)));
         Value* gnext2 = gnext;
-        if (!infinite) {
-            b_.CreateCondBr(is_last, exit, latch);
+        if (!infinite || (s.data.one_sided && !s.data.escape.present)) {
+            b_.CreateCondBr(is_last, exit, latch); // a one-sided bound gives no tail estimate
+        } else if (s.data.escape.present) {
+            // The escape certificate bounds every later term from the orbit point q_{i+1}.
+            BasicBlock* check = BasicBlock::Create(ctx_, "series.escape", fn_);
+            b_.CreateCondBr(is_last, exit, check);
+            b_.SetInsertPoint(check);
+            for (std::size_t c = 0; c < next_state.size(); ++c)
+                b_.CreateStore(next_state[c], b_.CreateConstInBoundsGEP1_64(dbl_, escape_state_, c));
+            const ir::OrbitEscape& e = s.data.escape;
+            Function* done_fn =
+                declare("frac_jit_escape_point_done", i32_,
+                        {i32_, dbl_, ptr_, i32_, i64_, dbl_, dbl_, dbl_, dbl_, dbl_, dbl_, dbl_});
+            Value* done = b_.CreateCall(
+                done_fn, {b_.getInt32(static_cast<std::uint32_t>(s.kind)), nacc, escape_state_,
+                          b_.getInt32(static_cast<std::uint32_t>(next_state.size())),
+                          b_.CreateAdd(i, b_.getInt64(1)), cst(e.radius), cst(e.slope), cst(e.offset),
+                          cst(e.scale0.lo), cst(e.scale0.hi), cst(e.growth.lo), cst(e.growth.hi)});
+            b_.CreateCondBr(b_.CreateICmpNE(done, b_.getInt32(0)), exit, latch);
         } else {
             BasicBlock* check = BasicBlock::Create(ctx_, "series.check", fn_);
             b_.CreateCondBr(is_last, exit, check);
@@ -297,6 +315,7 @@ private:
         b_.SetInsertPoint(exit);
         if (!infinite) return nacc;
         bump(capped_, b_.CreateZExt(is_last, i64_));
+        if (s.data.escape.present || s.data.one_sided) return nacc; // no tail estimate from a one-sided bound
         // The tail's midpoint, from ir::series_tail under upward rounding (as the interpreter does).
         Function* end_fn = declare("frac_jit_point_series_end", dbl_, {i32_, dbl_, dbl_, dbl_, i32_, dbl_, dbl_, i64_});
         return b_.CreateCall(end_fn, {b_.getInt32(static_cast<std::uint32_t>(s.kind)), nacc, vals_[s.tail_a],
@@ -330,6 +349,7 @@ private:
     Function* fn_ = nullptr;
     Value* terms_ = nullptr;
     Value* capped_ = nullptr;
+    Value* escape_state_ = nullptr; // the orbit point for the escape helper
     std::vector<Value*> vals_;
     std::vector<Value*> idx_;
     std::map<const void*, llvm::GlobalVariable*> globals_;

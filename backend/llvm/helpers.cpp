@@ -12,6 +12,21 @@ namespace num = frac::num;
 
 namespace {
 CInterval out(num::Interval v) { return {v.lo, v.hi}; }
+// The certificate of ir::OrbitEscape from the helpers' arguments.
+frac::ir::OrbitEscape escape_of(double radius, double slope, double offset, double scale0_lo,
+                                double scale0_hi, double growth_lo, double growth_hi, double lipschitz = 0.0,
+                                double map_lipschitz = 0.0) {
+    frac::ir::OrbitEscape e;
+    e.present = true;
+    e.radius = radius;
+    e.slope = slope;
+    e.offset = offset;
+    e.scale0 = {scale0_lo, scale0_hi};
+    e.growth = {growth_lo, growth_hi};
+    e.lipschitz = lipschitz;
+    e.map_lipschitz = map_lipschitz;
+    return e;
+}
 } // namespace
 
 extern "C" {
@@ -61,6 +76,64 @@ void frac_jit_vtail(int kind, const double* in, const std::int64_t* n, double* o
     }
 }
 
+void frac_jit_vescape(int kind, const double* in, const std::int64_t* n, double* out, int dims, double radius,
+                      double slope, double offset, double scale0_lo, double scale0_hi, double growth_lo,
+                      double growth_hi, double lipschitz, double map_lipschitz, const double* h,
+                      std::uint32_t mask, int lanes) noexcept {
+    const auto o = static_cast<frac::ir::Op>(kind);
+    const frac::ir::OrbitEscape e = escape_of(radius, slope, offset, scale0_lo, scale0_hi, growth_lo,
+                                              growth_hi, lipschitz, map_lipschitz);
+    num::Interval state[8];
+    for (int l = 0; l < lanes; ++l) {
+        if (!(mask >> l & 1)) {
+            out[l] = out[lanes + l] = o == frac::ir::Op::SeriesMax ? num::inf : -num::inf;
+            continue;
+        }
+        for (int c = 0; c < dims; ++c) state[c] = {in[2 * c * lanes + l], in[(2 * c + 1) * lanes + l]};
+        out[l] = frac::ir::escape_bound(o, e, state, dims, n[l]);
+        out[lanes + l] = frac::ir::escape_bound_around(o, e, state, dims, n[l], h ? h[l] : 0.0);
+    }
+}
+
+void frac_jit_vcentre(double* in, int dims, double* h, std::uint32_t mask, int lanes) noexcept {
+    num::Interval state[8];
+    for (int l = 0; l < lanes; ++l) {
+        h[l] = 0.0;
+        if (!(mask >> l & 1)) continue;
+        for (int c = 0; c < dims; ++c) state[c] = {in[2 * c * lanes + l], in[(2 * c + 1) * lanes + l]};
+        h[l] = frac::ir::lipschitz_centre(state, dims);
+        for (int c = 0; c < dims; ++c) {
+            in[2 * c * lanes + l] = state[c].lo;
+            in[(2 * c + 1) * lanes + l] = state[c].hi;
+        }
+    }
+}
+
+void frac_jit_vfinish(int kind, double* io, const double* bound, const std::int64_t* n, const double* h,
+                      double radius, double slope, double offset, double scale0_lo, double scale0_hi,
+                      double growth_lo, double growth_hi, double lipschitz, double map_lipschitz,
+                      std::uint32_t mask, int lanes) noexcept {
+    const auto o = static_cast<frac::ir::Op>(kind);
+    const frac::ir::OrbitEscape e = escape_of(radius, slope, offset, scale0_lo, scale0_hi, growth_lo,
+                                              growth_hi, lipschitz, map_lipschitz);
+    for (int l = 0; l < lanes; ++l) {
+        num::Interval r(0.0);
+        if (mask >> l & 1)
+            r = frac::ir::lipschitz_finish(o, e, {io[l], io[lanes + l]},
+                                           {io[2 * lanes + l], io[3 * lanes + l]}, bound[l], n[l], h[l]);
+        io[l] = r.lo;
+        io[lanes + l] = r.hi;
+    }
+}
+
+int frac_jit_escape_point_done(int kind, double acc, const double* state, int dims, std::int64_t n,
+                               double radius, double slope, double offset, double scale0_lo, double scale0_hi,
+                               double growth_lo, double growth_hi) noexcept {
+    const frac::ir::OrbitEscape e =
+        escape_of(radius, slope, offset, scale0_lo, scale0_hi, growth_lo, growth_hi);
+    return frac::ir::escape_point_done(static_cast<frac::ir::Op>(kind), e, acc, state, dims, n) ? 1 : 0;
+}
+
 double frac_jit_pow_point(double x, double y) noexcept { return std::pow(x, y); }
 double frac_jit_sin_point(double x) noexcept { return std::sin(x); }
 double frac_jit_cos_point(double x) noexcept { return std::cos(x); }
@@ -95,12 +168,31 @@ namespace frac::jit {
 const std::vector<Helper>& helpers() {
 #define FRAC_HELPER(fn) Helper{#fn, reinterpret_cast<void*>(&fn)}
     static const std::vector<Helper> list = {
-        FRAC_HELPER(frac_jit_div),       FRAC_HELPER(frac_jit_pow),       FRAC_HELPER(frac_jit_atan2),
-        FRAC_HELPER(frac_jit_sqrt),      FRAC_HELPER(frac_jit_sin),       FRAC_HELPER(frac_jit_cos),
-        FRAC_HELPER(frac_jit_tan),       FRAC_HELPER(frac_jit_exp),       FRAC_HELPER(frac_jit_log),
-        FRAC_HELPER(frac_jit_powi),      FRAC_HELPER(frac_jit_pow_point), FRAC_HELPER(frac_jit_sin_point),
-        FRAC_HELPER(frac_jit_cos_point), FRAC_HELPER(frac_jit_tan_point), FRAC_HELPER(frac_jit_exp_point),
-        FRAC_HELPER(frac_jit_log_point), FRAC_HELPER(frac_jit_atan2_point), FRAC_HELPER(frac_jit_series_tail), FRAC_HELPER(frac_jit_point_series_end), FRAC_HELPER(frac_jit_vop), FRAC_HELPER(frac_jit_vtail),
+        FRAC_HELPER(frac_jit_div),
+        FRAC_HELPER(frac_jit_pow),
+        FRAC_HELPER(frac_jit_atan2),
+        FRAC_HELPER(frac_jit_sqrt),
+        FRAC_HELPER(frac_jit_sin),
+        FRAC_HELPER(frac_jit_cos),
+        FRAC_HELPER(frac_jit_tan),
+        FRAC_HELPER(frac_jit_exp),
+        FRAC_HELPER(frac_jit_log),
+        FRAC_HELPER(frac_jit_powi),
+        FRAC_HELPER(frac_jit_pow_point),
+        FRAC_HELPER(frac_jit_sin_point),
+        FRAC_HELPER(frac_jit_cos_point),
+        FRAC_HELPER(frac_jit_tan_point),
+        FRAC_HELPER(frac_jit_exp_point),
+        FRAC_HELPER(frac_jit_log_point),
+        FRAC_HELPER(frac_jit_atan2_point),
+        FRAC_HELPER(frac_jit_series_tail),
+        FRAC_HELPER(frac_jit_point_series_end),
+        FRAC_HELPER(frac_jit_vop),
+        FRAC_HELPER(frac_jit_vtail),
+        FRAC_HELPER(frac_jit_vescape),
+        FRAC_HELPER(frac_jit_vcentre),
+        FRAC_HELPER(frac_jit_vfinish),
+        FRAC_HELPER(frac_jit_escape_point_done),
     };
 #undef FRAC_HELPER
     return list;

@@ -42,6 +42,26 @@ void frac_jit_vop(int op, std::int64_t imm, const double* in, double* out, std::
 // ir::series_tail per lane: in holds A.lo, A.hi, B.lo, B.hi (lanes each), n the index of each lane.
 void frac_jit_vtail(int kind, const double* in, const std::int64_t* n, double* out, int has_b, double gamma_lo,
                     double gamma_hi, std::uint32_t mask, int lanes) noexcept;
+// ir::escape_bound per lane: in holds, for each orbit component c, lanes lower bounds then lanes upper
+// bounds (in[2 c lanes + l], in[(2 c + 1) lanes + l]); n the index of each lane's orbit point; the
+// certificate's fields as arguments. Lanes outside the mask get the "no bound" value.
+// out[lanes + l]: ir::escape_bound_around with radius h[l] (h null: 0).
+void frac_jit_vescape(int kind, const double* in, const std::int64_t* n, double* out, int dims, double radius,
+                      double slope, double offset, double scale0_lo, double scale0_hi, double growth_lo,
+                      double growth_hi, double lipschitz, double map_lipschitz, const double* h,
+                      std::uint32_t mask, int lanes) noexcept;
+// ir::lipschitz_centre per lane, in place on `in` (laid out as for frac_jit_vescape); h out.
+void frac_jit_vcentre(double* in, int dims, double* h, std::uint32_t mask, int lanes) noexcept;
+// ir::lipschitz_finish per lane: io holds acc lo, acc hi, tail lo, tail hi (lanes each) and gets the
+// result's lo, hi; bound, n, h one per lane.
+void frac_jit_vfinish(int kind, double* io, const double* bound, const std::int64_t* n, const double* h,
+                      double radius, double slope, double offset, double scale0_lo, double scale0_hi,
+                      double growth_lo, double growth_hi, double lipschitz, double map_lipschitz,
+                      std::uint32_t mask, int lanes) noexcept;
+// ir::escape_point_done for the orbit point state[0..dims) (round to nearest): 1 when done.
+int frac_jit_escape_point_done(int kind, double acc, const double* state, int dims, std::int64_t n,
+                               double radius, double slope, double offset, double scale0_lo, double scale0_hi,
+                               double growth_lo, double growth_hi) noexcept;
 // Point operations (round to nearest), the C library's functions as the interpreter calls them.
 double frac_jit_pow_point(double x, double y) noexcept;
 double frac_jit_sin_point(double x) noexcept;

@@ -61,6 +61,10 @@ TEST_CASE("every grammar production parses", "[grammar]") {
          "(fn f (x) (min k 0 2 (orbit q (point x x) m) (. x q)))\n"},
         {"call of a function parameter", "fn ap(f, x) = f(x, sqrt);", "(fn ap (f x) (call f x sqrt))\n"},
         {"lambda", "const c = ap(fn (t, u) = t + u, 1);", "(const c (call ap (fn (t u) (+ t u)) 1))\n"},
+        {"orbit", "fn f(x) = min(k in 0..3, p in orbit((x, 0), m), p.x);",
+         "(fn f (x) (min k 0 3 (orbit p (point x 0) m) (. x p)))\n"},
+        {"orbit escape", "fn f(x) = min(k in 0.., p in orbit((x, 0), m) escape 1/2, p.x / 3^k);",
+         "(fn f (x) (min k 0 inf (orbit p (point x 0) m (escape (/ 1 2))) (/ (. x p) (^ 3 k))))\n"},
         {"comments", "// line\n/* block */ const c = 1; // end", "(const c 1)\n"},
     };
     for (const Case& c : cases) {

@@ -82,13 +82,21 @@ TEST_CASE("series of every kind agree: finite, infinite, with B, nested, orbits"
         "min(k in 0.., p in orbit((x, y), shrink), (sqrt(p.x^2 + p.y^2) - 0.3) / 2^k)",
         "min(k in 0.., p in orbit((x, y), swap), (dz(p.x) - 0.5 * dz(p.y)) / 2^k)",
         "max(k in 0.., p in orbit((x, y), grow), (dz(p.x) - abs(p.y)) / 3^k)",
+        // Escape certificates (frontend/orbit_escape): tails tightened from the orbit box.
+        "min(k in 0.., p in orbit((x, y), grow) escape 1/2, (sqrt(p.x^2 + p.y^2) - 0.2) / 3^k)",
+        "max(k in 0.., p in orbit((x, y), grow) escape 1, (0.7 - sqrt(p.x^2 + p.y^2)) / 3^k) + 0.01",
+        "min(k in 0.., p in orbit((x, y), fold) escape 1/2, (sqrt(p.x^2 + p.y^2) - 0.28) / 3^k)",
     };
-    const std::string maps = "fn shrink(p) = (p.x / 2 + 0.1, p.y / 2); fn swap(p) = (p.y, p.x);"
-                             "fn grow(p) = (3 * p.x, 3 * p.y - 1);";
+    const std::string maps =
+        "fn shrink(p) = (p.x / 2 + 0.1, p.y / 2); fn swap(p) = (p.y, p.x);"
+        "fn grow(p) = (3 * p.x, 3 * p.y - 1);"
+        "fn fold(p) = let r = sqrt(p.x^2 + p.y^2), f = pi / 3 * (2 * dz(atan2(abs(p.y), p.x) * "
+        "3 / pi / 2 + 1/4) - 1/2) in (3 * r * cos(f) - 1, 3 * r * sin(f));";
     int k = 0;
     for (const char* e : exprs) {
         auto c = front::compile_source("t.frac", maps + "shape s(x, y) = " + e + ";");
         INFO(e);
+        if (std::string(e).find("escape") != std::string::npos) REQUIRE(c->ok());
         if (!c->ok()) {
             WARN("not compiled: " << c->diags.render(c->sources));
             continue;
