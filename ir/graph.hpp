@@ -119,6 +119,8 @@ private:
 
 // Text form of the sub-graph reachable from `roots`, one node a line ("%4 = add %2, %3").
 std::string print_graph(const Graph& g, const std::vector<NodeId>& roots);
+// The text of an escape certificate, for the printers of the graph and the tape.
+std::string escape_text(const OrbitEscape& e);
 
 // Structural checks (arities, topological order, index levels, series invariants).
 // Returns an empty string when the graph is well formed, else a description of the first defect.

@@ -7,6 +7,15 @@
 
 namespace frac::ir {
 
+std::string escape_text(const OrbitEscape& e) {
+    std::string s =
+        fmt::format(" escape |q| > {}: terms >= ({} (|q| - {}) + {}) * [{}, {}] / [{}, {}]^i", e.radius,
+                    e.slope, e.radius, e.offset, e.scale0.lo, e.scale0.hi, e.growth.lo, e.growth.hi);
+    if (e.lipschitz > 0)
+        s += fmt::format(", term i {}-Lipschitz * ({} / growth)^i", e.lipschitz, e.map_lipschitz);
+    return s;
+}
+
 std::string print_graph(const Graph& g, const std::vector<NodeId>& roots) {
     std::vector<bool> live(g.size(), false);
     std::vector<NodeId> stack(roots.begin(), roots.end());

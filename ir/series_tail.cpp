@@ -1,7 +1,6 @@
 #include "ir/series_tail.hpp"
 
 #include <cmath>
-#include <fmt/format.h>
 #include <limits>
 #include <stdexcept>
 
@@ -151,15 +150,6 @@ bool escape_point_done(Op kind, const OrbitEscape& e, double acc, const double* 
                          (e.scale0.lo / std::pow(e.growth.lo, static_cast<double>(n)));
     const double slack = 0x1p-54 * std::fabs(acc);
     return kind == Op::SeriesMax ? -bound <= acc + slack : bound >= acc - slack;
-}
-
-std::string escape_text(const OrbitEscape& e) {
-    std::string s =
-        fmt::format(" escape |q| > {}: terms >= ({} (|q| - {}) + {}) * [{}, {}] / [{}, {}]^i", e.radius,
-                    e.slope, e.radius, e.offset, e.scale0.lo, e.scale0.hi, e.growth.lo, e.growth.hi);
-    if (e.lipschitz > 0)
-        s += fmt::format(", term i {}-Lipschitz * ({} / growth)^i", e.lipschitz, e.map_lipschitz);
-    return s;
 }
 
 Interval series_combine(Op kind, Interval acc, Interval term) {

@@ -22,7 +22,6 @@ Interval series_term_bound(Interval a, Interval b, bool has_b, Interval gamma_i,
 // escape ball. `escape_tighten` intersects a tail enclosure with it; every engine uses these two.
 double escape_bound(Op kind, const OrbitEscape& e, const Interval* state, int dims, std::int64_t n);
 Interval escape_tighten(Op kind, Interval tail, double bound);
-std::string escape_text(const OrbitEscape& e); // for the printers
 
 // Lipschitz enclosures (OrbitEscape::lipschitz > 0). `lipschitz_centre` replaces the initial point's
 // box by its centre (thin) and returns the radius h of the box around it (rounded up); with an
