@@ -23,7 +23,9 @@ using namespace frac;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 struct Shape {
     std::string name;
@@ -61,7 +63,8 @@ bool same(ir::Interval a, ir::Interval b) {
 }
 
 // Seconds to evaluate every box once, in batches of 4096, best of `reps`.
-double eval_all(ir::Evaluator& e, const std::vector<ir::Interval>& boxes, std::vector<ir::Interval>& out, int reps) {
+double eval_all(ir::Evaluator& e, const std::vector<ir::Interval>& boxes, std::vector<ir::Interval>& out,
+                int reps) {
     const std::size_t n = boxes.size() / 2;
     out.resize(n);
     double best = 1e300;
@@ -107,7 +110,8 @@ int main(int argc, char** argv) {
         }
         for (const front::ShapeInfo& s : c->module.shapes)
             if (seen.insert(s.name).second)
-                shapes.push_back({s.name, s.dimension, s.box, ir::build_tape(c->module.graph, s.root, s.dimension)});
+                shapes.push_back(
+                    {s.name, s.dimension, s.box, ir::build_tape(c->module.graph, s.root, s.dimension)});
     }
     const Shape* carpet = nullptr;
     for (const Shape& s : shapes)
@@ -119,10 +123,11 @@ int main(int argc, char** argv) {
     std::string json = "{\n";
     json += fmt::format("  \"jit_init_ms\": {:.3f},\n", init_ms);
 
-    // ---- 1. LLVM compile time per shape: the first compile (which also warms LLVM up) and the best of three ----
+    // ---- 1. LLVM compile time per shape: the first compile (which also warms LLVM up) and the best of three
+    // ----
     fmt::print("LLVM compile time per shape (ms; JIT initialisation once: {:.1f} ms)\n", init_ms);
-    fmt::print("{:<20} {:>6} {:>9} {:>8} {:>8} {:>9} {:>9} {:>9} {:>8}\n", "shape", "instrs", "total", "tables",
-               "codegen", "optimise", "machine", "first", "IR ops");
+    fmt::print("{:<20} {:>6} {:>9} {:>8} {:>8} {:>9} {:>9} {:>9} {:>8}\n", "shape", "instrs", "total",
+               "tables", "codegen", "optimise", "machine", "first", "IR ops");
     json += "  \"compile\": [\n";
     double worst_compile = 0;
     std::string worst_shape;
@@ -143,14 +148,15 @@ int main(int argc, char** argv) {
             worst_shape = s.name;
         }
         fmt::print("{:<20} {:>6} {:>9.2f} {:>8.2f} {:>8.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>8}\n", s.name,
-                   s.tape.instruction_count(), ci.total_ms, ci.tables_ms, ci.codegen_ms, ci.optimize_ms, ci.machine_ms,
-                   first_ms, ci.ir_instructions);
-        json += fmt::format("    {{\"shape\": \"{}\", \"tape_instructions\": {}, \"total_ms\": {:.3f}, \"tables_ms\": {:.3f}, "
-                            "\"codegen_ms\": {:.3f}, \"optimize_ms\": {:.3f}, \"machine_ms\": {:.3f}, \"first_ms\": {:.3f}, "
-                            "\"ir_instructions\": {}}}{}\n",
-                            json_escape(s.name), s.tape.instruction_count(), ci.total_ms, ci.tables_ms, ci.codegen_ms,
-                            ci.optimize_ms, ci.machine_ms, first_ms, ci.ir_instructions,
-                            i + 1 < shapes.size() ? "," : "");
+                   s.tape.instruction_count(), ci.total_ms, ci.tables_ms, ci.codegen_ms, ci.optimize_ms,
+                   ci.machine_ms, first_ms, ci.ir_instructions);
+        json += fmt::format(
+            "    {{\"shape\": \"{}\", \"tape_instructions\": {}, \"total_ms\": {:.3f}, \"tables_ms\": "
+            "{:.3f}, "
+            "\"codegen_ms\": {:.3f}, \"optimize_ms\": {:.3f}, \"machine_ms\": {:.3f}, \"first_ms\": {:.3f}, "
+            "\"ir_instructions\": {}}}{}\n",
+            json_escape(s.name), s.tape.instruction_count(), ci.total_ms, ci.tables_ms, ci.codegen_ms,
+            ci.optimize_ms, ci.machine_ms, first_ms, ci.ir_instructions, i + 1 < shapes.size() ? "," : "");
     }
     json += "  ],\n";
 
@@ -162,11 +168,12 @@ int main(int argc, char** argv) {
     auto j1 = jit::make_jit(carpet->tape, {}, scalar_config); // one box at a time, like the C++ below
     auto hw = bench::make_carpet_handwritten();
     const jit::CompileInfo& jinfo = *jit::compile_info(*jt);
-    fmt::print("\nJIT code: {} rounding, {} boxes per vector (and a scalar variant, 1 box)\n", jinfo.rounding, jinfo.lanes);
+    fmt::print("\nJIT code: {} rounding, {} boxes per vector (and a scalar variant, 1 box)\n", jinfo.rounding,
+               jinfo.lanes);
     json += fmt::format("  \"jit_rounding\": \"{}\",\n  \"jit_lanes\": {},\n", jinfo.rounding, jinfo.lanes);
     fmt::print("\nCarpet RSS cover (best of runs, one thread)\n");
-    fmt::print("{:<6} {:<12} {:>11} {:>10} {:>13} {:>9} {:>11}\n", "depth", "engine", "boxes", "seconds", "boxes/s",
-               "terms/box", "vs interp");
+    fmt::print("{:<6} {:<12} {:>11} {:>10} {:>13} {:>9} {:>11}\n", "depth", "engine", "boxes", "seconds",
+               "boxes/s", "terms/box", "vs interp");
     json += "  \"carpet\": [\n";
     struct CarpetRow {
         int depth;
@@ -182,9 +189,11 @@ int main(int argc, char** argv) {
         const std::pair<const char*, const Cover*> engines[] = {
             {"interp", &row.interp}, {"jit", &row.jit}, {"jit x1", &row.jit1}, {"handwritten", &row.hand}};
         for (const auto& [name, c] : engines) {
-            fmt::print("{:<6} {:<12} {:>11} {:>10.3f} {:>13.0f} {:>9.2f} {:>10.2f}x\n", d, name, c->boxes, c->seconds,
-                       c->boxes / c->seconds, double(c->terms) / double(c->boxes), row.interp.seconds / c->seconds);
-            json += fmt::format("    {{\"depth\": {}, \"engine\": \"{}\", \"boxes\": {}, \"boundary\": {}, \"series_terms\": {}, "
+            fmt::print("{:<6} {:<12} {:>11} {:>10.3f} {:>13.0f} {:>9.2f} {:>10.2f}x\n", d, name, c->boxes,
+                       c->seconds, c->boxes / c->seconds, double(c->terms) / double(c->boxes),
+                       row.interp.seconds / c->seconds);
+            json += fmt::format("    {{\"depth\": {}, \"engine\": \"{}\", \"boxes\": {}, \"boundary\": {}, "
+                                "\"series_terms\": {}, "
                                 "\"seconds\": {:.6f}, \"boxes_per_second\": {:.1f}}},\n",
                                 d, name, c->boxes, c->boundary, c->terms, c->seconds, c->boxes / c->seconds);
         }
@@ -226,25 +235,29 @@ int main(int argc, char** argv) {
         diff_hand += !same(oi[i], oh[i]);
     }
     const double ns = 1e9 / double(n_boxes);
-    fmt::print("\nCarpet, per evaluated box ({} cells of the depth-{} cover, batches of 4096, best of runs)\n", n_boxes,
-               depth);
+    fmt::print(
+        "\nCarpet, per evaluated box ({} cells of the depth-{} cover, batches of 4096, best of runs)\n",
+        n_boxes, depth);
     fmt::print("  interpreter  {:>8.1f} ns/box\n", t_in * ns);
-    fmt::print("  JIT          {:>8.1f} ns/box   interpreter / JIT = {:.2f}x   JIT / hand-written = {:.3f}x\n",
-               t_jit * ns, t_in / t_jit, t_jit / t_hand);
-    fmt::print("  JIT x1       {:>8.1f} ns/box   interpreter / JIT = {:.2f}x   JIT / hand-written = {:.3f}x\n",
-               t_j1 * ns, t_in / t_j1, t_j1 / t_hand);
+    fmt::print(
+        "  JIT          {:>8.1f} ns/box   interpreter / JIT = {:.2f}x   JIT / hand-written = {:.3f}x\n",
+        t_jit * ns, t_in / t_jit, t_jit / t_hand);
+    fmt::print(
+        "  JIT x1       {:>8.1f} ns/box   interpreter / JIT = {:.2f}x   JIT / hand-written = {:.3f}x\n",
+        t_j1 * ns, t_in / t_j1, t_j1 / t_hand);
     fmt::print("  hand-written {:>8.1f} ns/box   (scalar C++, -O2 -march=native)\n", t_hand * ns);
-    fmt::print("  enclosures differing from the interpreter's: JIT {}, JIT x1 {}, hand-written {}\n", diff_jit, diff_j1,
-               diff_hand);
-    json += fmt::format("  \"carpet_per_box\": {{\"depth\": {}, \"boxes\": {}, \"interp_ns\": {:.2f}, \"jit_ns\": {:.2f}, "
-                        "\"jit_scalar_ns\": {:.2f}, \"handwritten_ns\": {:.2f}, \"jit_mismatches\": {}, "
-                        "\"jit_scalar_mismatches\": {}, \"handwritten_mismatches\": {}}},\n",
-                        depth, n_boxes, t_in * ns, t_jit * ns, t_j1 * ns, t_hand * ns, diff_jit, diff_j1, diff_hand);
+    fmt::print("  enclosures differing from the interpreter's: JIT {}, JIT x1 {}, hand-written {}\n",
+               diff_jit, diff_j1, diff_hand);
+    json += fmt::format(
+        "  \"carpet_per_box\": {{\"depth\": {}, \"boxes\": {}, \"interp_ns\": {:.2f}, \"jit_ns\": {:.2f}, "
+        "\"jit_scalar_ns\": {:.2f}, \"handwritten_ns\": {:.2f}, \"jit_mismatches\": {}, "
+        "\"jit_scalar_mismatches\": {}, \"handwritten_mismatches\": {}}},\n",
+        depth, n_boxes, t_in * ns, t_jit * ns, t_j1 * ns, t_hand * ns, diff_jit, diff_j1, diff_hand);
 
     // ---- 4. Every stdlib shape: interpreter against JIT ----
     fmt::print("\nEvery stdlib shape, RSS cover (2D at depth {}, 3D at depth {})\n", depth, depth_3d);
-    fmt::print("{:<20} {:>5} {:>11} {:>11} {:>10} {:>10} {:>12} {:>9}\n", "shape", "depth", "boxes", "terms/box",
-               "interp s", "jit s", "jit boxes/s", "speed-up");
+    fmt::print("{:<20} {:>5} {:>11} {:>11} {:>10} {:>10} {:>12} {:>9}\n", "shape", "depth", "boxes",
+               "terms/box", "interp s", "jit s", "jit boxes/s", "speed-up");
     json += "  \"shapes\": [\n";
     for (std::size_t i = 0; i < shapes.size(); ++i) {
         const Shape& s = shapes[i];
@@ -257,13 +270,14 @@ int main(int argc, char** argv) {
         const Cover ci = cover(*ei, s.box, d, 1);
         const Cover cj = cover(*ej, s.box, d, 3);
         const bool agree = ci.boundary == cj.boundary && ci.terms == cj.terms && ci.boxes == cj.boxes;
-        fmt::print("{:<20} {:>5} {:>11} {:>11.2f} {:>10.3f} {:>10.3f} {:>12.0f} {:>8.2f}x{}\n", s.name, d, cj.boxes,
-                   double(cj.terms) / double(cj.boxes), ci.seconds, cj.seconds, cj.boxes / cj.seconds,
-                   ci.seconds / cj.seconds, agree ? "" : "  COVERS DIFFER");
-        json += fmt::format("    {{\"shape\": \"{}\", \"depth\": {}, \"boxes\": {}, \"series_terms\": {}, "
-                            "\"interp_seconds\": {:.6f}, \"jit_seconds\": {:.6f}, \"speedup\": {:.3f}, \"agree\": {}}}{}\n",
-                            json_escape(s.name), d, cj.boxes, cj.terms, ci.seconds, cj.seconds,
-                            ci.seconds / cj.seconds, agree ? "true" : "false", i + 1 < shapes.size() ? "," : "");
+        fmt::print("{:<20} {:>5} {:>11} {:>11.2f} {:>10.3f} {:>10.3f} {:>12.0f} {:>8.2f}x{}\n", s.name, d,
+                   cj.boxes, double(cj.terms) / double(cj.boxes), ci.seconds, cj.seconds,
+                   cj.boxes / cj.seconds, ci.seconds / cj.seconds, agree ? "" : "  COVERS DIFFER");
+        json += fmt::format(
+            "    {{\"shape\": \"{}\", \"depth\": {}, \"boxes\": {}, \"series_terms\": {}, "
+            "\"interp_seconds\": {:.6f}, \"jit_seconds\": {:.6f}, \"speedup\": {:.3f}, \"agree\": {}}}{}\n",
+            json_escape(s.name), d, cj.boxes, cj.terms, ci.seconds, cj.seconds, ci.seconds / cj.seconds,
+            agree ? "true" : "false", i + 1 < shapes.size() ? "," : "");
     }
     json += "  ],\n";
 
@@ -274,14 +288,15 @@ int main(int argc, char** argv) {
     fmt::print("\nTargets\n");
     fmt::print("  JIT >= 10x interpreter, carpet cover depth {}:   {:>7.2f}x   {}\n", depth, speedup,
                speedup >= 10 ? "met" : "MISSED");
-    fmt::print("  JIT within 1.2x of hand-written C++ per box:     {:>7.3f}x   {}  (scalar JIT: {:.3f}x)\n", vs_hand,
-               vs_hand <= 1.2 ? "met" : "MISSED", t_j1 / t_hand);
-    fmt::print("  LLVM compile < 50 ms per stdlib shape (worst):   {:>7.2f} ms ({})   {}\n", worst_compile, worst_shape,
-               worst_compile < 50 ? "met" : "MISSED");
-    json += fmt::format("  \"targets\": {{\"jit_vs_interp_carpet\": {:.3f}, \"jit_vs_handwritten_per_box\": {:.4f}, "
-                        "\"jit_scalar_vs_handwritten_per_box\": {:.4f}, \"worst_compile_ms\": {:.3f}, "
-                        "\"worst_compile_shape\": \"{}\"}}\n}}\n",
-                        speedup, vs_hand, t_j1 / t_hand, worst_compile, json_escape(worst_shape));
+    fmt::print("  JIT within 1.2x of hand-written C++ per box:     {:>7.3f}x   {}  (scalar JIT: {:.3f}x)\n",
+               vs_hand, vs_hand <= 1.2 ? "met" : "MISSED", t_j1 / t_hand);
+    fmt::print("  LLVM compile < 50 ms per stdlib shape (worst):   {:>7.2f} ms ({})   {}\n", worst_compile,
+               worst_shape, worst_compile < 50 ? "met" : "MISSED");
+    json += fmt::format(
+        "  \"targets\": {{\"jit_vs_interp_carpet\": {:.3f}, \"jit_vs_handwritten_per_box\": {:.4f}, "
+        "\"jit_scalar_vs_handwritten_per_box\": {:.4f}, \"worst_compile_ms\": {:.3f}, "
+        "\"worst_compile_shape\": \"{}\"}}\n}}\n",
+        speedup, vs_hand, t_j1 / t_hand, worst_compile, json_escape(worst_shape));
     std::ofstream(json_path) << json;
     fmt::print("wrote {}\n", json_path);
     return 0;

@@ -19,12 +19,24 @@ inline double opaque(double x) {
     asm("" : "+x"(x));
     return x;
 }
-inline double add_down(double x, double y) { return -opaque(opaque(-x) - y); }
-inline double sub_down(double x, double y) { return -opaque(opaque(-x) + y); }
-inline double mul_down(double x, double y) { return -opaque(opaque(-x) * y); }
-inline double div_down(double x, double y) { return -opaque(opaque(-x) / y); }
-inline double mn(double a, double b) { return b < a ? b : a; }
-inline double mx(double a, double b) { return a < b ? b : a; }
+inline double add_down(double x, double y) {
+    return -opaque(opaque(-x) - y);
+}
+inline double sub_down(double x, double y) {
+    return -opaque(opaque(-x) + y);
+}
+inline double mul_down(double x, double y) {
+    return -opaque(opaque(-x) * y);
+}
+inline double div_down(double x, double y) {
+    return -opaque(opaque(-x) / y);
+}
+inline double mn(double a, double b) {
+    return b < a ? b : a;
+}
+inline double mx(double a, double b) {
+    return a < b ? b : a;
+}
 
 // x * p with p > 0 and finite (a table entry 3^i): the four corners of interval.cpp's product,
 // zero factors giving 0, in the same order.
@@ -36,8 +48,12 @@ inline Interval mul_pos(Interval x, Interval p) {
     const double u2 = zh ? 0.0 : x.hi * p.lo, u3 = zh ? 0.0 : x.hi * p.hi;
     return {mn(mn(mn(d0, d1), d2), d3), mx(mx(mx(u0, u1), u2), u3)};
 }
-inline double dz_down(double x) { return mn(sub_down(x, std::floor(x)), sub_down(std::ceil(x), x)); }
-inline double dz_up(double x) { return mn(x - std::floor(x), std::ceil(x) - x); }
+inline double dz_down(double x) {
+    return mn(sub_down(x, std::floor(x)), sub_down(std::ceil(x), x));
+}
+inline double dz_up(double x) {
+    return mn(x - std::floor(x), std::ceil(x) - x);
+}
 inline Interval dz_box(Interval a) {
     if (!(a.hi - a.lo < 1)) return {0.0, 0.5};
     double lo = mn(dz_down(a.lo), dz_down(a.hi));
@@ -67,7 +83,8 @@ inline Interval div_pos(Interval a, Interval p) {
 class Carpet final : public ir::Evaluator {
 public:
     explicit Carpet(int max_terms) : max_terms_(max_terms) {
-        if (max_terms < 1 || max_terms > ir::max_terms_limit) throw std::invalid_argument("max_terms out of range");
+        if (max_terms < 1 || max_terms > ir::max_terms_limit)
+            throw std::invalid_argument("max_terms out of range");
         // The constants of the carpet's tape: 1/3 and the tail coefficient A = 1/3 - [0, 1/2] over the
         // same enclosures; gamma = 1/3.
         num::UpwardRounding up;
@@ -130,6 +147,8 @@ private:
 
 } // namespace
 
-std::unique_ptr<ir::Evaluator> make_carpet_handwritten(int max_terms) { return std::make_unique<Carpet>(max_terms); }
+std::unique_ptr<ir::Evaluator> make_carpet_handwritten(int max_terms) {
+    return std::make_unique<Carpet>(max_terms);
+}
 
 } // namespace frac::bench

@@ -73,8 +73,8 @@ bool Graph::KeyEq::operator()(const Node& a, const Node& b) const {
            a.series.level == b.series.level && a.series.start == b.series.start &&
            a.series.end == b.series.end && bits(a.series.gamma.lo) == bits(b.series.gamma.lo) &&
            bits(a.series.gamma.hi) == bits(b.series.gamma.hi) &&
-           a.series.state_count == b.series.state_count && a.orbit == b.orbit && a.series.one_sided == b.series.one_sided &&
-           same_escape(a.series.escape, b.series.escape);
+           a.series.state_count == b.series.state_count && a.orbit == b.orbit &&
+           a.series.one_sided == b.series.one_sided && same_escape(a.series.escape, b.series.escape);
 }
 
 NodeId Graph::intern(const Node& n) {

@@ -72,10 +72,13 @@ public:
         i64_ = Type::getInt64Ty(ctx_);
         i32_ = Type::getInt32Ty(ctx_);
         ptr_ = llvm::PointerType::get(ctx_, 0);
-        vt_ = w_ == 1 ? dbl_ : static_cast<Type*>(llvm::FixedVectorType::get(dbl_, static_cast<unsigned>(w_)));
+        vt_ =
+            w_ == 1 ? dbl_ : static_cast<Type*>(llvm::FixedVectorType::get(dbl_, static_cast<unsigned>(w_)));
         mt_ = w_ == 1 ? Type::getInt1Ty(ctx_)
-                      : static_cast<Type*>(llvm::FixedVectorType::get(Type::getInt1Ty(ctx_), static_cast<unsigned>(w_)));
-        vi64_ = w_ == 1 ? i64_ : static_cast<Type*>(llvm::FixedVectorType::get(i64_, static_cast<unsigned>(w_)));
+                      : static_cast<Type*>(
+                            llvm::FixedVectorType::get(Type::getInt1Ty(ctx_), static_cast<unsigned>(w_)));
+        vi64_ =
+            w_ == 1 ? i64_ : static_cast<Type*>(llvm::FixedVectorType::get(i64_, static_cast<unsigned>(w_)));
         pair_ = llvm::StructType::get(ctx_, {dbl_, dbl_});
         if (!avx512_) {
             b_.setIsFPConstrained(true);
@@ -147,7 +150,8 @@ public:
         if (w_ == 1) {
             ctx_mask_ = b_.getTrue();
         } else {
-            Value* lanes = b_.CreateAdd(b_.CreateVectorSplat(static_cast<unsigned>(w_), first_box), lane_numbers());
+            Value* lanes =
+                b_.CreateAdd(b_.CreateVectorSplat(static_cast<unsigned>(w_), first_box), lane_numbers());
             ctx_mask_ = b_.CreateICmpULT(lanes, b_.CreateVectorSplat(static_cast<unsigned>(w_), n));
         }
 
@@ -168,10 +172,12 @@ public:
             for (int half = 0; half < 2; ++half) {
                 Value* v = w_ == 1 ? nullptr : static_cast<Value*>(llvm::PoisonValue::get(vt_));
                 for (int l = 0; l < w_; ++l) {
-                    Value* at = b_.CreateAdd(b_.CreateMul(box_of_lane[static_cast<std::size_t>(l)], b_.getInt64(2 * d)),
-                                             b_.getInt64(2 * j + static_cast<std::uint64_t>(half)));
+                    Value* at = b_.CreateAdd(
+                        b_.CreateMul(box_of_lane[static_cast<std::size_t>(l)], b_.getInt64(2 * d)),
+                        b_.getInt64(2 * j + static_cast<std::uint64_t>(half)));
                     Value* x = b_.CreateLoad(dbl_, b_.CreateInBoundsGEP(dbl_, in, at));
-                    v = w_ == 1 ? x : b_.CreateInsertElement(v, x, b_.getInt64(static_cast<std::uint64_t>(l)));
+                    v = w_ == 1 ? x
+                                : b_.CreateInsertElement(v, x, b_.getInt64(static_cast<std::uint64_t>(l)));
                 }
                 (half ? st.v.hi : st.v.lo) = v;
             }
@@ -190,7 +196,8 @@ public:
         }
         Value* k1 = b_.CreateAdd(k, b_.getInt64(1));
         k->addIncoming(k1, b_.GetInsertBlock());
-        b_.CreateCondBr(b_.CreateICmpUGE(b_.CreateMul(k1, b_.getInt64(static_cast<std::uint64_t>(w_))), n), done, loop);
+        b_.CreateCondBr(b_.CreateICmpUGE(b_.CreateMul(k1, b_.getInt64(static_cast<std::uint64_t>(w_))), n),
+                        done, loop);
 
         b_.SetInsertPoint(done);
         add_stat(stats, 0, n);
@@ -228,7 +235,9 @@ private:
         Value* p = b_.CreateInBoundsGEP(i64_, stats, b_.getInt64(static_cast<std::uint64_t>(field)));
         b_.CreateStore(b_.CreateAdd(b_.CreateLoad(i64_, p), v), p);
     }
-    void bump(Value* counter, Value* by) { b_.CreateStore(b_.CreateAdd(b_.CreateLoad(i64_, counter), by), counter); }
+    void bump(Value* counter, Value* by) {
+        b_.CreateStore(b_.CreateAdd(b_.CreateLoad(i64_, counter), by), counter);
+    }
 
     // ---- floating point, rounded upward ----
     static constexpr int ru_sae = 2 | 8; // _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC
@@ -247,19 +256,23 @@ private:
     }
     Value* add(Value* x, Value* y) {
         using namespace llvm::Intrinsic;
-        return avx512_ ? x86_round(x86_avx512_mask_add_sd_round, x86_avx512_add_pd_512, x, y) : b_.CreateFAdd(x, y);
+        return avx512_ ? x86_round(x86_avx512_mask_add_sd_round, x86_avx512_add_pd_512, x, y)
+                       : b_.CreateFAdd(x, y);
     }
     Value* sub(Value* x, Value* y) {
         using namespace llvm::Intrinsic;
-        return avx512_ ? x86_round(x86_avx512_mask_sub_sd_round, x86_avx512_sub_pd_512, x, y) : b_.CreateFSub(x, y);
+        return avx512_ ? x86_round(x86_avx512_mask_sub_sd_round, x86_avx512_sub_pd_512, x, y)
+                       : b_.CreateFSub(x, y);
     }
     Value* mul(Value* x, Value* y) {
         using namespace llvm::Intrinsic;
-        return avx512_ ? x86_round(x86_avx512_mask_mul_sd_round, x86_avx512_mul_pd_512, x, y) : b_.CreateFMul(x, y);
+        return avx512_ ? x86_round(x86_avx512_mask_mul_sd_round, x86_avx512_mul_pd_512, x, y)
+                       : b_.CreateFMul(x, y);
     }
     Value* div(Value* x, Value* y) {
         using namespace llvm::Intrinsic;
-        return avx512_ ? x86_round(x86_avx512_mask_div_sd_round, x86_avx512_div_pd_512, x, y) : b_.CreateFDiv(x, y);
+        return avx512_ ? x86_round(x86_avx512_mask_div_sd_round, x86_avx512_div_pd_512, x, y)
+                       : b_.CreateFDiv(x, y);
     }
     Value* neg(Value* x) { return b_.CreateFNeg(x); }
     Value* add_down(Value* x, Value* y) { return neg(sub(neg(x), y)); }
@@ -328,7 +341,9 @@ private:
         if (!is_empty) return r;
         return {sel(is_empty, if_empty.lo, r.lo), sel(is_empty, if_empty.hi, r.hi)};
     }
-    IV widen_nan(Value* lo, Value* hi) { return {sel(isnan(lo), cst(-inf), lo), sel(isnan(hi), cst(inf), hi)}; }
+    IV widen_nan(Value* lo, Value* hi) {
+        return {sel(isnan(lo), cst(-inf), lo), sel(isnan(hi), cst(inf), hi)};
+    }
     Value* is_zero(const SlotState& s, bool upper) {
         if (s.known) return i1((upper ? s.k.hi : s.k.lo) == 0);
         if (upper ? s.f.hi_nonzero : s.f.lo_nonzero) return i1(false);
@@ -378,19 +393,24 @@ private:
     }
     IV call_vector(Op op, std::int64_t imm, const std::vector<IV>& args, Value* mask) {
         for (std::size_t a = 0; a < args.size(); ++a) {
-            b_.CreateStore(args[a].lo, b_.CreateConstInBoundsGEP1_64(dbl_, scratch_in_, 2 * a * static_cast<std::uint64_t>(w_)));
-            b_.CreateStore(args[a].hi,
-                           b_.CreateConstInBoundsGEP1_64(dbl_, scratch_in_, (2 * a + 1) * static_cast<std::uint64_t>(w_)));
+            b_.CreateStore(args[a].lo, b_.CreateConstInBoundsGEP1_64(dbl_, scratch_in_,
+                                                                     2 * a * static_cast<std::uint64_t>(w_)));
+            b_.CreateStore(args[a].hi, b_.CreateConstInBoundsGEP1_64(
+                                           dbl_, scratch_in_, (2 * a + 1) * static_cast<std::uint64_t>(w_)));
         }
         auto callee = m_.getOrInsertFunction(
-            "frac_jit_vop", llvm::FunctionType::get(Type::getVoidTy(ctx_), {i32_, i64_, ptr_, ptr_, i32_, i32_}, false));
+            "frac_jit_vop",
+            llvm::FunctionType::get(Type::getVoidTy(ctx_), {i32_, i64_, ptr_, ptr_, i32_, i32_}, false));
         llvm::cast<Function>(callee.getCallee())->setDoesNotThrow();
-        b_.CreateCall(callee, {b_.getInt32(static_cast<std::uint32_t>(op)), b_.getInt64(static_cast<std::uint64_t>(imm)),
-                               scratch_in_, scratch_out_, mask_bits(mask), b_.getInt32(static_cast<std::uint32_t>(w_))});
+        b_.CreateCall(callee, {b_.getInt32(static_cast<std::uint32_t>(op)),
+                               b_.getInt64(static_cast<std::uint64_t>(imm)), scratch_in_, scratch_out_,
+                               mask_bits(mask), b_.getInt32(static_cast<std::uint32_t>(w_))});
         return {b_.CreateLoad(vt_, scratch_out_),
-                b_.CreateLoad(vt_, b_.CreateConstInBoundsGEP1_64(dbl_, scratch_out_, static_cast<std::uint64_t>(w_)))};
+                b_.CreateLoad(
+                    vt_, b_.CreateConstInBoundsGEP1_64(dbl_, scratch_out_, static_cast<std::uint64_t>(w_)))};
     }
-    SlotState call_core(Op op, std::int64_t imm, const std::vector<const SlotState*>& args, bool maybe_empty) {
+    SlotState call_core(Op op, std::int64_t imm, const std::vector<const SlotState*>& args,
+                        bool maybe_empty) {
         if (w_ > 1) {
             std::vector<IV> v;
             for (const SlotState* a : args) v.push_back(a->v);
@@ -465,15 +485,18 @@ private:
         Value* alo_nonneg = ge(a.v.lo, cst(0.0));
         Value* ahi_nonpos = le(a.v.hi, cst(0.0));
         Value* lo_num = sel(pos, a.v.lo, a.v.hi);
-        Value* lo_den = sel(pos, sel(alo_nonneg, b.v.hi, b.v.lo), sel(land(lnot(alo_nonneg), ahi_nonpos), b.v.lo, b.v.hi));
+        Value* lo_den = sel(pos, sel(alo_nonneg, b.v.hi, b.v.lo),
+                            sel(land(lnot(alo_nonneg), ahi_nonpos), b.v.lo, b.v.hi));
         Value* hi_num = sel(pos, a.v.hi, a.v.lo);
-        Value* hi_den = sel(pos, sel(alo_nonneg, b.v.lo, sel(ahi_nonpos, b.v.hi, b.v.lo)), sel(alo_nonneg, b.v.lo, b.v.hi));
+        Value* hi_den = sel(pos, sel(alo_nonneg, b.v.lo, sel(ahi_nonpos, b.v.hi, b.v.lo)),
+                            sel(alo_nonneg, b.v.lo, b.v.hi));
         return widen_nan(div_down(lo_num, lo_den), div(hi_num, hi_den));
     }
     SlotState op_div(const SlotState& a, const SlotState& b) {
         // A divisor of statically known sign: the branch the interpreter takes.
         if (b.f.lo_positive || b.f.hi_negative)
-            return result(guard(empty_of(a), div_nonzero(a, b, i1(b.f.lo_positive)), empty()), a.f.maybe_empty);
+            return result(guard(empty_of(a), div_nonzero(a, b, i1(b.f.lo_positive)), empty()),
+                          a.f.maybe_empty);
         Value* pos = gt(b.v.lo, cst(0.0));
         Value* fast = b_.CreateOr(pos, lt(b.v.hi, cst(0.0)));
         if (Value* e = lor(empty_of(a), empty_of(b))) fast = land(fast, lnot(e));
@@ -511,7 +534,9 @@ private:
         Value* hi = sel(lo_nonneg, a.hi, sel(hi_nonpos, nlo, std_max(nlo, a.hi)));
         return {lo, hi};
     }
-    SlotState op_abs(const SlotState& a) { return result(guard(empty_of(a), abs_nonempty(a.v), a.v), a.f.maybe_empty); }
+    SlotState op_abs(const SlotState& a) {
+        return result(guard(empty_of(a), abs_nonempty(a.v), a.v), a.f.maybe_empty);
+    }
     Value* pow_up(Value* x, std::uint64_t n) {
         Value* r = cst(1.0);
         for (Value* p = x;; p = mul(p, p)) {
@@ -535,12 +560,15 @@ private:
         Value* hi = sel(ge(a.hi, cst(0.0)), pow_up(a.hi, n), neg(pow_down(neg(a.hi), n)));
         return {lo, hi};
     }
-    SlotState op_sqr(const SlotState& a) { return result(guard(empty_of(a), pow_positive(a.v, 2), a.v), a.f.maybe_empty); }
+    SlotState op_sqr(const SlotState& a) {
+        return result(guard(empty_of(a), pow_positive(a.v, 2), a.v), a.f.maybe_empty);
+    }
     SlotState op_powi(const SlotState& a, std::int64_t n) {
         if (n == 0) return result(guard(empty_of(a), {cst(1.0), cst(1.0)}, a.v), a.f.maybe_empty);
         // Negative powers divide; huge ones would unroll for nothing: the core does both.
         if (n < 0 || n > 1024) return call_core(Op::PowI, n, {&a}, true);
-        return result(guard(empty_of(a), pow_positive(a.v, static_cast<std::uint64_t>(n)), a.v), a.f.maybe_empty);
+        return result(guard(empty_of(a), pow_positive(a.v, static_cast<std::uint64_t>(n)), a.v),
+                      a.f.maybe_empty);
     }
     SlotState op_minmax(const SlotState& a, const SlotState& b, bool is_min) {
         Value* e = lor(empty_of(a), empty_of(b));
@@ -568,8 +596,10 @@ private:
         Value* cl = ceil(lo);
         Value* fh = floor(hi);
         Value* ch = ceil(hi);
-        // dz_down(x) = min(sub_down(x, floor x), sub_down(ceil x, x)); dz_up(x) = min(x - floor x, ceil x - x)
-        Value* rlo = std_min(std_min(sub_down(lo, fl), sub_down(cl, lo)), std_min(sub_down(hi, fh), sub_down(ch, hi)));
+        // dz_down(x) = min(sub_down(x, floor x), sub_down(ceil x, x)); dz_up(x) = min(x - floor x, ceil x -
+        // x)
+        Value* rlo =
+            std_min(std_min(sub_down(lo, fl), sub_down(cl, lo)), std_min(sub_down(hi, fh), sub_down(ch, hi)));
         Value* rhi = std_max(std_min(sub(lo, fl), sub(cl, lo)), std_min(sub(hi, fh), sub(ch, hi)));
         rlo = sel(le(cl, hi), cst(0.0), rlo);
         Value* half = add(fl, cst(0.5));
@@ -648,7 +678,8 @@ private:
         case Op::Cos:
         case Op::Tan:
         case Op::Exp: return call_core(ins.op, 0, {&in(0)}, in(0).f.maybe_empty);
-        case Op::Atan2: return call_core(ins.op, 0, {&in(0), &in(1)}, in(0).f.maybe_empty || in(1).f.maybe_empty);
+        case Op::Atan2:
+            return call_core(ins.op, 0, {&in(0), &in(1)}, in(0).f.maybe_empty || in(1).f.maybe_empty);
         case Op::Lt:
         case Op::Le:
         case Op::Gt:
@@ -707,7 +738,8 @@ private:
         Value* lo = llvm::PoisonValue::get(vt_);
         Value* hi = llvm::PoisonValue::get(vt_);
         for (int l = 0; l < w_; ++l) {
-            Value* i2 = b_.CreateShl(b_.CreateExtractElement(idx, b_.getInt64(static_cast<std::uint64_t>(l))), 1);
+            Value* i2 =
+                b_.CreateShl(b_.CreateExtractElement(idx, b_.getInt64(static_cast<std::uint64_t>(l))), 1);
             Value* x = b_.CreateLoad(dbl_, b_.CreateInBoundsGEP(dbl_, g, i2));
             Value* y = b_.CreateLoad(dbl_, b_.CreateInBoundsGEP(dbl_, g, b_.CreateOr(i2, b_.getInt64(1))));
             lo = b_.CreateInsertElement(lo, x, b_.getInt64(static_cast<std::uint64_t>(l)));
@@ -736,27 +768,35 @@ private:
     SlotState tail_core(const TapeSeries& s, const SlotState& a, const SlotState& bc, bool has_b, Value* n,
                         Value* mask) {
         if (w_ == 1) {
-            return result(call_scalar("frac_jit_series_tail",
-                                      {b_.getInt32(static_cast<std::uint32_t>(s.kind)), a.v.lo, a.v.hi, bc.v.lo, bc.v.hi,
-                                       b_.getInt32(has_b ? 1 : 0), llvm::ConstantFP::get(dbl_, s.data.gamma.lo),
-                                       llvm::ConstantFP::get(dbl_, s.data.gamma.hi), n}),
-                          true);
+            return result(
+                call_scalar("frac_jit_series_tail", {b_.getInt32(static_cast<std::uint32_t>(s.kind)), a.v.lo,
+                                                     a.v.hi, bc.v.lo, bc.v.hi, b_.getInt32(has_b ? 1 : 0),
+                                                     llvm::ConstantFP::get(dbl_, s.data.gamma.lo),
+                                                     llvm::ConstantFP::get(dbl_, s.data.gamma.hi), n}),
+                true);
         }
         b_.CreateStore(a.v.lo, b_.CreateConstInBoundsGEP1_64(dbl_, scratch_in_, 0));
-        b_.CreateStore(a.v.hi, b_.CreateConstInBoundsGEP1_64(dbl_, scratch_in_, static_cast<std::uint64_t>(w_)));
-        b_.CreateStore(bc.v.lo, b_.CreateConstInBoundsGEP1_64(dbl_, scratch_in_, 2 * static_cast<std::uint64_t>(w_)));
-        b_.CreateStore(bc.v.hi, b_.CreateConstInBoundsGEP1_64(dbl_, scratch_in_, 3 * static_cast<std::uint64_t>(w_)));
-        b_.CreateStore(n->getType()->isVectorTy() ? n : b_.CreateVectorSplat(static_cast<unsigned>(w_), n), scratch_n_);
+        b_.CreateStore(a.v.hi,
+                       b_.CreateConstInBoundsGEP1_64(dbl_, scratch_in_, static_cast<std::uint64_t>(w_)));
+        b_.CreateStore(bc.v.lo,
+                       b_.CreateConstInBoundsGEP1_64(dbl_, scratch_in_, 2 * static_cast<std::uint64_t>(w_)));
+        b_.CreateStore(bc.v.hi,
+                       b_.CreateConstInBoundsGEP1_64(dbl_, scratch_in_, 3 * static_cast<std::uint64_t>(w_)));
+        b_.CreateStore(n->getType()->isVectorTy() ? n : b_.CreateVectorSplat(static_cast<unsigned>(w_), n),
+                       scratch_n_);
         auto callee = m_.getOrInsertFunction(
-            "frac_jit_vtail", llvm::FunctionType::get(Type::getVoidTy(ctx_),
-                                                      {i32_, ptr_, ptr_, ptr_, i32_, dbl_, dbl_, i32_, i32_}, false));
+            "frac_jit_vtail",
+            llvm::FunctionType::get(Type::getVoidTy(ctx_),
+                                    {i32_, ptr_, ptr_, ptr_, i32_, dbl_, dbl_, i32_, i32_}, false));
         llvm::cast<Function>(callee.getCallee())->setDoesNotThrow();
-        b_.CreateCall(callee, {b_.getInt32(static_cast<std::uint32_t>(s.kind)), scratch_in_, scratch_n_, scratch_out_,
-                               b_.getInt32(has_b ? 1 : 0), llvm::ConstantFP::get(dbl_, s.data.gamma.lo),
-                               llvm::ConstantFP::get(dbl_, s.data.gamma.hi), mask_bits(mask),
-                               b_.getInt32(static_cast<std::uint32_t>(w_))});
+        b_.CreateCall(callee,
+                      {b_.getInt32(static_cast<std::uint32_t>(s.kind)), scratch_in_, scratch_n_, scratch_out_,
+                       b_.getInt32(has_b ? 1 : 0), llvm::ConstantFP::get(dbl_, s.data.gamma.lo),
+                       llvm::ConstantFP::get(dbl_, s.data.gamma.hi), mask_bits(mask),
+                       b_.getInt32(static_cast<std::uint32_t>(w_))});
         return result({b_.CreateLoad(vt_, scratch_out_),
-                       b_.CreateLoad(vt_, b_.CreateConstInBoundsGEP1_64(dbl_, scratch_out_, static_cast<std::uint64_t>(w_)))},
+                       b_.CreateLoad(vt_, b_.CreateConstInBoundsGEP1_64(dbl_, scratch_out_,
+                                                                        static_cast<std::uint64_t>(w_)))},
                       true);
     }
 
@@ -884,7 +924,8 @@ private:
         acc_lo->addIncoming(cst(0.0), pre);
         acc_hi->addIncoming(cst(0.0), pre);
         active->addIncoming(outer_mask, pre);
-        stop_at->addIncoming(w_ == 1 ? start_v : b_.CreateVectorSplat(static_cast<unsigned>(w_), start_v), pre);
+        stop_at->addIncoming(w_ == 1 ? start_v : b_.CreateVectorSplat(static_cast<unsigned>(w_), start_v),
+                             pre);
         std::vector<std::pair<llvm::PHINode*, llvm::PHINode*>> state_phis; // orbit series: the point
         for (std::size_t c = 0; c < s.state_slots.size(); ++c) {
             llvm::PHINode* lo = b_.CreatePHI(vt_, 2, "state.lo");
@@ -910,7 +951,8 @@ private:
         }
         Value* idx = b_.CreateSub(i, start_v, "idx");
         idx_[ins.series] = idx;
-        const bool exact = std::max(std::fabs(static_cast<double>(start)), std::fabs(static_cast<double>(last))) < 0x1p52;
+        const bool exact =
+            std::max(std::fabs(static_cast<double>(start)), std::fabs(static_cast<double>(last))) < 0x1p52;
         states_[s.index_slot] = thin(splat(index_to_double(i, exact)));
 
         ctx_mask_ = active;
@@ -918,7 +960,8 @@ private:
 
         // The next orbit point, all components from this term's point (a map (p.y, p.x) swaps).
         std::vector<IV> next_state;
-        for (std::size_t c = 0; c < s.state_slots.size(); ++c) next_state.push_back(states_[s.update_slots[c]].v);
+        for (std::size_t c = 0; c < s.state_slots.size(); ++c)
+            next_state.push_back(states_[s.update_slots[c]].v);
         const SlotState term = states_[s.body_slot];
         // Escape certificate: the bound of the terms after i from the next orbit point.
         Value* esc_now = nullptr; // the bound from the orbit box
@@ -929,18 +972,20 @@ private:
         const SlotState comb = combine(s.kind, acc, term);
         Value* first = splat(b_.CreateICmpEQ(i, start_v));
         // Lanes that stopped keep their partial result.
-        SlotState nacc = result({sel(first, term.v.lo, comb.v.lo), sel(first, term.v.hi, comb.v.hi)}, term.f.maybe_empty);
+        SlotState nacc =
+            result({sel(first, term.v.lo, comb.v.lo), sel(first, term.v.hi, comb.v.hi)}, term.f.maybe_empty);
         if (w_ > 1) nacc.v = {sel(active, nacc.v.lo, acc_lo), sel(active, nacc.v.hi, acc_hi)};
         bump(terms_, count(active));
         Value* is_last = b_.CreateICmpEQ(i, b_.getInt64(static_cast<std::uint64_t>(last)));
         // At the last index every active lane stops, capped by the term limit (infinite series).
-        Value* splat_i = w_ == 1 ? static_cast<Value*>(i) : b_.CreateVectorSplat(static_cast<unsigned>(w_), i);
+        Value* splat_i =
+            w_ == 1 ? static_cast<Value*>(i) : b_.CreateVectorSplat(static_cast<unsigned>(w_), i);
         Value* last_at = w_ == 1 ? static_cast<Value*>(i) : b_.CreateSelect(active, splat_i, stop_at);
         Value* esc_last = escape ? (w_ == 1 ? esc_far : sel(active, esc_far, esc_frozen)) : nullptr;
         Value* esc_next = esc_frozen;
         BasicBlock* from_last = b_.GetInsertBlock();
         BasicBlock* latch = BasicBlock::Create(ctx_, "series.next", fn_);
-        Value* still = active;        // lanes that go on to the next term
+        Value* still = active; // lanes that go on to the next term
         Value* stop_at_next = stop_at;
         BasicBlock* decided = nullptr; // the block that leaves when every lane stopped by a rule
         if (!infinite) {
@@ -977,7 +1022,8 @@ private:
             SlotState tail;
             Value* tail_width;
             if (st.const_tail) {
-                tail = from_table(load_pair(table(&st.tail, st.tail, "tail"), idx), facts_of(st.tail.data(), st.tail.size()));
+                tail = from_table(load_pair(table(&st.tail, st.tail, "tail"), idx),
+                                  facts_of(st.tail.data(), st.tail.size()));
                 tail_width = load_scalar(table(&st.tail_width, st.tail_width, "tail_width"), idx);
             } else {
                 tail = tail_core(s, a, bc, has_b, i, rest);
@@ -987,7 +1033,8 @@ private:
                 tail = escape_tighten(s.kind, tail, esc_now);
                 tail_width = width(tail);
             }
-            Value* small = b_.CreateOr(le(tail_width, mul(cst(0x1p-52), magnitude(nacc))), eq(tail_width, cst(0.0)));
+            Value* small =
+                b_.CreateOr(le(tail_width, mul(cst(0x1p-52), magnitude(nacc))), eq(tail_width, cst(0.0)));
             if (s.kind == Op::SeriesMin) {
                 Value* one_sided = eq(fabs(tail.v.hi), cst(inf));
                 Value* no_gain = land(ge(tail.v.lo, nacc.v.lo), ge(term.v.hi, nacc.v.hi));
@@ -1054,10 +1101,12 @@ private:
             esc_final->addIncoming(esc_next, decided);
         }
         bump(capped_, count(capped_lanes));
-        Value* final_idx = b_.CreateSub(final_at, w_ == 1 ? start_v : b_.CreateVectorSplat(static_cast<unsigned>(w_), start_v));
+        Value* final_idx = b_.CreateSub(
+            final_at, w_ == 1 ? start_v : b_.CreateVectorSplat(static_cast<unsigned>(w_), start_v));
         SlotState tail;
         if (st.const_tail)
-            tail = from_table(gather_pair(table(&st.tail, st.tail, "tail"), final_idx), facts_of(st.tail.data(), st.tail.size()));
+            tail = from_table(gather_pair(table(&st.tail, st.tail, "tail"), final_idx),
+                              facts_of(st.tail.data(), st.tail.size()));
         else
             tail = tail_core(s, a, bc, has_b, final_at, outer_mask);
         if (lipschitz) return lipschitz_finish(s, nacc, tail, esc_final, final_at, outer_mask);
@@ -1075,7 +1124,8 @@ private:
             const int tix = tab_.slot_table[ins.out];
             if (tix >= 0) {
                 const IndexTable& it = tab_.index_tables[static_cast<std::size_t>(tix)];
-                states_[ins.out] = from_table(load_pair(table(&it.box, it.box, "index"), idx_[it.series]), it.facts);
+                states_[ins.out] =
+                    from_table(load_pair(table(&it.box, it.box, "index"), idx_[it.series]), it.facts);
                 continue;
             }
             states_[ins.out] = emit_op(ins);
@@ -1114,7 +1164,8 @@ private:
 } // namespace
 
 std::string generate_box_function(const Tape& tape, const ir::EvalOptions& options, const Tables& tables,
-                                  llvm::Module& module, const std::string& name, Rounding rounding, int lanes) {
+                                  llvm::Module& module, const std::string& name, Rounding rounding,
+                                  int lanes) {
     return BoxGen(tape, options, tables, module, name, rounding, lanes).run();
 }
 

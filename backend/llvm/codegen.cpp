@@ -100,7 +100,8 @@ protected:
 
 class PointGen : Common {
 public:
-    PointGen(const Tape& t, const ir::EvalOptions& o, const Tables& tab, llvm::Module& m, const std::string& name)
+    PointGen(const Tape& t, const ir::EvalOptions& o, const Tables& tab, llvm::Module& m,
+             const std::string& name)
         : Common(t, o, tab, m, name), b_(m.getContext()) {}
 
     std::string run() {
@@ -152,11 +153,17 @@ private:
         Value* p = b_.CreateInBoundsGEP(i64_, stats, b_.getInt64(static_cast<std::uint64_t>(field)));
         b_.CreateStore(b_.CreateAdd(b_.CreateLoad(i64_, p), v), p);
     }
-    void bump(Value* counter, Value* by) { b_.CreateStore(b_.CreateAdd(b_.CreateLoad(i64_, counter), by), counter); }
+    void bump(Value* counter, Value* by) {
+        b_.CreateStore(b_.CreateAdd(b_.CreateLoad(i64_, counter), by), counter);
+    }
     Value* sel(Value* c, Value* x, Value* y) { return b_.CreateSelect(c, x, y); }
     Value* bool_to_double(Value* c) { return sel(c, cst(1.0), cst(0.0)); }
-    Value* c_fmin(Value* x, Value* y) { return sel(b_.CreateFCmpOLE(x, y), x, sel(b_.CreateFCmpUNO(y, y), x, y)); }
-    Value* c_fmax(Value* x, Value* y) { return sel(b_.CreateFCmpOGE(x, y), x, sel(b_.CreateFCmpUNO(y, y), x, y)); }
+    Value* c_fmin(Value* x, Value* y) {
+        return sel(b_.CreateFCmpOLE(x, y), x, sel(b_.CreateFCmpUNO(y, y), x, y));
+    }
+    Value* c_fmax(Value* x, Value* y) {
+        return sel(b_.CreateFCmpOGE(x, y), x, sel(b_.CreateFCmpUNO(y, y), x, y));
+    }
     Value* std_min(Value* x, Value* y) { return sel(b_.CreateFCmpOLT(y, x), y, x); }
     Value* intrinsic(llvm::Intrinsic::ID id, Value* x) { return b_.CreateUnaryIntrinsic(id, x); }
     Value* call(const char* helper, std::vector<Value*> args) {
@@ -317,7 +324,8 @@ private:
         bump(capped_, b_.CreateZExt(is_last, i64_));
         if (s.data.escape.present || s.data.one_sided) return nacc; // no tail estimate from a one-sided bound
         // The tail's midpoint, from ir::series_tail under upward rounding (as the interpreter does).
-        Function* end_fn = declare("frac_jit_point_series_end", dbl_, {i32_, dbl_, dbl_, dbl_, i32_, dbl_, dbl_, i64_});
+        Function* end_fn =
+            declare("frac_jit_point_series_end", dbl_, {i32_, dbl_, dbl_, dbl_, i32_, dbl_, dbl_, i64_});
         return b_.CreateCall(end_fn, {b_.getInt32(static_cast<std::uint32_t>(s.kind)), nacc, vals_[s.tail_a],
                                       has_b ? vals_[s.tail_b] : cst(0.0), b_.getInt32(has_b ? 1 : 0),
                                       cst(s.data.gamma.lo), cst(s.data.gamma.hi), i});
@@ -357,8 +365,8 @@ private:
 
 } // namespace
 
-GeneratedNames generate(const Tape& tape, const ir::EvalOptions& options, const Tables& tables, llvm::Module& module,
-                        const std::string& name, Rounding rounding, int lanes) {
+GeneratedNames generate(const Tape& tape, const ir::EvalOptions& options, const Tables& tables,
+                        llvm::Module& module, const std::string& name, Rounding rounding, int lanes) {
     GeneratedNames names;
     names.box = generate_box_function(tape, options, tables, module, name, rounding, lanes);
     names.point = PointGen(tape, options, tables, module, name).run();

@@ -11,7 +11,9 @@ using frac::jit::CInterval;
 namespace num = frac::num;
 
 namespace {
-CInterval out(num::Interval v) { return {v.lo, v.hi}; }
+CInterval out(num::Interval v) {
+    return {v.lo, v.hi};
+}
 // The certificate of ir::OrbitEscape from the helpers' arguments.
 frac::ir::OrbitEscape escape_of(double radius, double slope, double offset, double scale0_lo,
                                 double scale0_hi, double growth_lo, double growth_hi, double lipschitz = 0.0,
@@ -40,15 +42,30 @@ CInterval frac_jit_pow(double alo, double ahi, double blo, double bhi) noexcept 
 CInterval frac_jit_atan2(double ylo, double yhi, double xlo, double xhi) noexcept {
     return out(num::atan2({ylo, yhi}, {xlo, xhi}));
 }
-CInterval frac_jit_sqrt(double lo, double hi) noexcept { return out(num::sqrt({lo, hi})); }
-CInterval frac_jit_sin(double lo, double hi) noexcept { return out(num::sin({lo, hi})); }
-CInterval frac_jit_cos(double lo, double hi) noexcept { return out(num::cos({lo, hi})); }
-CInterval frac_jit_tan(double lo, double hi) noexcept { return out(num::tan({lo, hi})); }
-CInterval frac_jit_exp(double lo, double hi) noexcept { return out(num::exp({lo, hi})); }
-CInterval frac_jit_log(double lo, double hi) noexcept { return out(num::log({lo, hi})); }
-CInterval frac_jit_powi(double lo, double hi, std::int64_t n) noexcept { return out(num::powi({lo, hi}, n)); }
+CInterval frac_jit_sqrt(double lo, double hi) noexcept {
+    return out(num::sqrt({lo, hi}));
+}
+CInterval frac_jit_sin(double lo, double hi) noexcept {
+    return out(num::sin({lo, hi}));
+}
+CInterval frac_jit_cos(double lo, double hi) noexcept {
+    return out(num::cos({lo, hi}));
+}
+CInterval frac_jit_tan(double lo, double hi) noexcept {
+    return out(num::tan({lo, hi}));
+}
+CInterval frac_jit_exp(double lo, double hi) noexcept {
+    return out(num::exp({lo, hi}));
+}
+CInterval frac_jit_log(double lo, double hi) noexcept {
+    return out(num::log({lo, hi}));
+}
+CInterval frac_jit_powi(double lo, double hi, std::int64_t n) noexcept {
+    return out(num::powi({lo, hi}, n));
+}
 
-void frac_jit_vop(int op, std::int64_t imm, const double* in, double* out, std::uint32_t mask, int lanes) noexcept {
+void frac_jit_vop(int op, std::int64_t imm, const double* in, double* out, std::uint32_t mask,
+                  int lanes) noexcept {
     const auto o = static_cast<frac::ir::Op>(op);
     const int arity = frac::ir::arity(o);
     for (int l = 0; l < lanes; ++l) {
@@ -63,14 +80,14 @@ void frac_jit_vop(int op, std::int64_t imm, const double* in, double* out, std::
     }
 }
 
-void frac_jit_vtail(int kind, const double* in, const std::int64_t* n, double* out, int has_b, double gamma_lo,
-                    double gamma_hi, std::uint32_t mask, int lanes) noexcept {
+void frac_jit_vtail(int kind, const double* in, const std::int64_t* n, double* out, int has_b,
+                    double gamma_lo, double gamma_hi, std::uint32_t mask, int lanes) noexcept {
     const auto o = static_cast<frac::ir::Op>(kind);
     for (int l = 0; l < lanes; ++l) {
         num::Interval r(0.0);
         if (mask >> l & 1)
-            r = frac::ir::series_tail(o, {in[l], in[lanes + l]}, {in[2 * lanes + l], in[3 * lanes + l]}, has_b != 0,
-                                      {gamma_lo, gamma_hi}, n[l]);
+            r = frac::ir::series_tail(o, {in[l], in[lanes + l]}, {in[2 * lanes + l], in[3 * lanes + l]},
+                                      has_b != 0, {gamma_lo, gamma_hi}, n[l]);
         out[l] = r.lo;
         out[lanes + l] = r.hi;
     }
@@ -134,16 +151,30 @@ int frac_jit_escape_point_done(int kind, double acc, const double* state, int di
     return frac::ir::escape_point_done(static_cast<frac::ir::Op>(kind), e, acc, state, dims, n) ? 1 : 0;
 }
 
-double frac_jit_pow_point(double x, double y) noexcept { return std::pow(x, y); }
-double frac_jit_sin_point(double x) noexcept { return std::sin(x); }
-double frac_jit_cos_point(double x) noexcept { return std::cos(x); }
-double frac_jit_tan_point(double x) noexcept { return std::tan(x); }
-double frac_jit_exp_point(double x) noexcept { return std::exp(x); }
-double frac_jit_log_point(double x) noexcept { return std::log(x); }
-double frac_jit_atan2_point(double y, double x) noexcept { return std::atan2(y, x); }
+double frac_jit_pow_point(double x, double y) noexcept {
+    return std::pow(x, y);
+}
+double frac_jit_sin_point(double x) noexcept {
+    return std::sin(x);
+}
+double frac_jit_cos_point(double x) noexcept {
+    return std::cos(x);
+}
+double frac_jit_tan_point(double x) noexcept {
+    return std::tan(x);
+}
+double frac_jit_exp_point(double x) noexcept {
+    return std::exp(x);
+}
+double frac_jit_log_point(double x) noexcept {
+    return std::log(x);
+}
+double frac_jit_atan2_point(double y, double x) noexcept {
+    return std::atan2(y, x);
+}
 
-CInterval frac_jit_series_tail(int kind, double alo, double ahi, double blo, double bhi, int has_b, double gamma_lo,
-                               double gamma_hi, std::int64_t n) noexcept {
+CInterval frac_jit_series_tail(int kind, double alo, double ahi, double blo, double bhi, int has_b,
+                               double gamma_lo, double gamma_hi, std::int64_t n) noexcept {
     return out(frac::ir::series_tail(static_cast<frac::ir::Op>(kind), {alo, ahi}, {blo, bhi}, has_b != 0,
                                      {gamma_lo, gamma_hi}, n));
 }
@@ -154,8 +185,8 @@ double frac_jit_point_series_end(int kind, double acc, double a, double b, int h
     num::Interval tail;
     {
         num::UpwardRounding up;
-        tail = frac::ir::series_tail(op, num::Interval(a), has_b ? num::Interval(b) : num::Interval(0.0), has_b != 0,
-                                     {gamma_lo, gamma_hi}, n);
+        tail = frac::ir::series_tail(op, num::Interval(a), has_b ? num::Interval(b) : num::Interval(0.0),
+                                     has_b != 0, {gamma_lo, gamma_hi}, n);
     }
     if (!std::isfinite(tail.lo) || !std::isfinite(tail.hi)) return acc;
     return frac::ir::series_combine_point(op, acc, num::midpoint(tail));
@@ -166,7 +197,10 @@ double frac_jit_point_series_end(int kind, double acc, double a, double b, int h
 namespace frac::jit {
 
 const std::vector<Helper>& helpers() {
-#define FRAC_HELPER(fn) Helper{#fn, reinterpret_cast<void*>(&fn)}
+#define FRAC_HELPER(fn)                                                                                      \
+    Helper {                                                                                                 \
+#fn, reinterpret_cast < void*>(&fn)                                                                  \
+    }
     static const std::vector<Helper> list = {
         FRAC_HELPER(frac_jit_div),
         FRAC_HELPER(frac_jit_pow),

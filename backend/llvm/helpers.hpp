@@ -36,12 +36,13 @@ frac::jit::CInterval frac_jit_exp(double lo, double hi) noexcept;
 frac::jit::CInterval frac_jit_log(double lo, double hi) noexcept;
 frac::jit::CInterval frac_jit_powi(double lo, double hi, std::int64_t n) noexcept;
 // Vector code: ir::apply_interval(op, args, imm) for each lane l < lanes whose bit is set in `mask`.
-// in: for each operand k, lanes lower bounds then lanes upper bounds (in[2 k lanes + l], in[(2 k + 1) lanes + l]);
-// out: lanes lower bounds, then lanes upper bounds (lanes outside the mask get 0).
-void frac_jit_vop(int op, std::int64_t imm, const double* in, double* out, std::uint32_t mask, int lanes) noexcept;
+// in: for each operand k, lanes lower bounds then lanes upper bounds (in[2 k lanes + l], in[(2 k + 1) lanes +
+// l]); out: lanes lower bounds, then lanes upper bounds (lanes outside the mask get 0).
+void frac_jit_vop(int op, std::int64_t imm, const double* in, double* out, std::uint32_t mask,
+                  int lanes) noexcept;
 // ir::series_tail per lane: in holds A.lo, A.hi, B.lo, B.hi (lanes each), n the index of each lane.
-void frac_jit_vtail(int kind, const double* in, const std::int64_t* n, double* out, int has_b, double gamma_lo,
-                    double gamma_hi, std::uint32_t mask, int lanes) noexcept;
+void frac_jit_vtail(int kind, const double* in, const std::int64_t* n, double* out, int has_b,
+                    double gamma_lo, double gamma_hi, std::uint32_t mask, int lanes) noexcept;
 // ir::escape_bound per lane: in holds, for each orbit component c, lanes lower bounds then lanes upper
 // bounds (in[2 c lanes + l], in[(2 c + 1) lanes + l]); n the index of each lane's orbit point; the
 // certificate's fields as arguments. Lanes outside the mask get the "no bound" value.

@@ -104,16 +104,17 @@ private:
         }
         // One target machine for every compile (compiles are serialised by `mu`): LLJIT's default
         // creates a new one per module, a few milliseconds each time.
-        auto jit = llvm::orc::LLJITBuilder()
-                       .setJITTargetMachineBuilder(*jtmb)
-                       .setCompileFunctionCreator(
-                           [](llvm::orc::JITTargetMachineBuilder b)
-                               -> llvm::Expected<std::unique_ptr<llvm::orc::IRCompileLayer::IRCompiler>> {
-                               auto machine = b.createTargetMachine();
-                               if (!machine) return machine.takeError();
-                               return std::make_unique<llvm::orc::TMOwningSimpleCompiler>(std::move(*machine));
-                           })
-                       .create();
+        auto jit =
+            llvm::orc::LLJITBuilder()
+                .setJITTargetMachineBuilder(*jtmb)
+                .setCompileFunctionCreator(
+                    [](llvm::orc::JITTargetMachineBuilder b)
+                        -> llvm::Expected<std::unique_ptr<llvm::orc::IRCompileLayer::IRCompiler>> {
+                        auto machine = b.createTargetMachine();
+                        if (!machine) return machine.takeError();
+                        return std::make_unique<llvm::orc::TMOwningSimpleCompiler>(std::move(*machine));
+                    })
+                .create();
         if (!jit) {
             error = "cannot start the LLVM ORC JIT: " + to_string(jit.takeError());
             return nullptr;
@@ -149,8 +150,7 @@ std::size_t table_bytes(const Tables& t) {
     std::size_t n = 0;
     for (const IndexTable& x : t.index_tables) n += x.box.size() * 16 + x.point.size() * 8;
     for (const SeriesTables& s : t.series)
-        n += s.threshold.size() * 8 + s.tail.size() * 16 + s.tail_width.size() * 8 +
-             s.gamma_n.size() * 16;
+        n += s.threshold.size() * 8 + s.tail.size() * 16 + s.tail_width.size() * 8 + s.gamma_n.size() * 16;
     return n;
 }
 
@@ -289,7 +289,9 @@ private:
 
 } // namespace
 
-bool jit_available(std::string* why) { return Engine::get(why) != nullptr; }
+bool jit_available(std::string* why) {
+    return Engine::get(why) != nullptr;
+}
 
 bool host_has_avx512() {
     Engine* e = Engine::get(nullptr);
@@ -335,7 +337,8 @@ std::shared_ptr<const Compiled> compile(const ir::Tape& tape, const ir::EvalOpti
     t = Clock::now();
     llvm::orc::JITDylib& jd = engine->jit->getMainJITDylib();
     code->tracker = jd.createResourceTracker();
-    if (auto err = engine->jit->addIRModule(code->tracker, llvm::orc::ThreadSafeModule(std::move(g.module), std::move(g.ctx))))
+    if (auto err = engine->jit->addIRModule(
+            code->tracker, llvm::orc::ThreadSafeModule(std::move(g.module), std::move(g.ctx))))
         throw JitError("the LLVM JIT rejected a module: " + to_string(std::move(err)));
     auto box = engine->jit->lookup(g.names.box);
     if (!box) throw JitError("the LLVM JIT could not compile a shape: " + to_string(box.takeError()));
@@ -374,7 +377,8 @@ const CompileInfo* compile_info(const ir::Evaluator& e) {
     return j ? &j->info() : nullptr;
 }
 
-std::string emit_llvm(const ir::Tape& tape, const ir::EvalOptions& options, bool optimized, const JitConfig& config) {
+std::string emit_llvm(const ir::Tape& tape, const ir::EvalOptions& options, bool optimized,
+                      const JitConfig& config) {
     check_options(tape, options);
     std::string why;
     Engine* engine = Engine::get(&why);
@@ -382,7 +386,8 @@ std::string emit_llvm(const ir::Tape& tape, const ir::EvalOptions& options, bool
     const Tables tables = build_tables(tape, options);
     std::lock_guard<std::mutex> lock(engine->mu);
     const Rounding rounding = engine->rounding_for(config);
-    Generated g = generate_module(tape, options, tables, "frac", engine, rounding, engine->lanes_for(config, rounding));
+    Generated g =
+        generate_module(tape, options, tables, "frac", engine, rounding, engine->lanes_for(config, rounding));
     if (optimized) optimize(*g.module, engine->tm.get());
     std::string s;
     llvm::raw_string_ostream os(s);

@@ -6,7 +6,8 @@
 // including series term counts (EvalStats). eval_box / eval_boxes set upward rounding once per call;
 // the generated interval code uses LLVM's constrained floating-point intrinsics ("round.upward",
 // "fpexcept.ignore"), so the optimiser cannot fold or reorder it as if it rounded to nearest, and
-// computes lower bounds as -RU(-x op y) like the numeric core. See docs/design.md and backend/llvm/codegen.hpp.
+// computes lower bounds as -RU(-x op y) like the numeric core. See docs/design.md and
+// backend/llvm/codegen.hpp.
 //
 // Only backend/llvm includes LLVM headers; this header does not.
 #pragma once
@@ -58,11 +59,11 @@ inline constexpr ir::PruneCosts jit_prune_costs{/*eval_ns_per_cost=*/0.8, /*comp
 
 // What compiling one tape cost (wall clock, milliseconds), for benchmarks and --verbose output.
 struct CompileInfo {
-    double tables_ms = 0;   // index and series tables
-    double codegen_ms = 0;  // tape -> LLVM IR
-    double optimize_ms = 0; // LLVM IR passes
-    double machine_ms = 0;  // instruction selection, emission and linking in the JIT
-    double total_ms = 0;    // make_jit from start to finish
+    double tables_ms = 0;            // index and series tables
+    double codegen_ms = 0;           // tape -> LLVM IR
+    double optimize_ms = 0;          // LLVM IR passes
+    double machine_ms = 0;           // instruction selection, emission and linking in the JIT
+    double total_ms = 0;             // make_jit from start to finish
     std::size_t ir_instructions = 0; // after optimisation
     std::size_t table_bytes = 0;
     std::string rounding; // "avx512" or "constrained"

@@ -50,8 +50,9 @@ std::int64_t last_index(const TapeSeries& s, const ir::EvalOptions& o) {
     return s.data.end == ir::infinite_end ? s.data.start + o.max_terms - 1 : s.data.end;
 }
 
-void series_tables(const Tape& t, const TapeSeries& s, const ir::EvalOptions& o, const std::vector<bool>& is_const,
-                   const std::vector<Interval>& const_box, SeriesTables& out) {
+void series_tables(const Tape& t, const TapeSeries& s, const ir::EvalOptions& o,
+                   const std::vector<bool>& is_const, const std::vector<Interval>& const_box,
+                   SeriesTables& out) {
     out.infinite = s.data.end == ir::infinite_end;
     out.first = s.data.start;
     out.last = last_index(s, o);
@@ -115,7 +116,8 @@ void analyse(const Tape& t, Tables& out) {
             }
             if (out.slot_table[ins.out] >= 0) continue; // an index table: its facts are exact
             bool in[3] = {false, false, false};
-            for (int k = 0; k < ir::arity(ins.op); ++k) in[k] = f[ins.in[static_cast<std::size_t>(k)]].maybe_empty;
+            for (int k = 0; k < ir::arity(ins.op); ++k)
+                in[k] = f[ins.in[static_cast<std::size_t>(k)]].maybe_empty;
             const Facts divisor = ins.op == Op::Div ? f[ins.in[1]] : Facts{};
             set(ins.out, may_be_empty(ins.op, in, ins.imm, divisor));
         }
@@ -158,7 +160,8 @@ bool may_be_empty(Op op, const bool* in, std::int64_t imm, const Facts& divisor)
     case Op::Exp:
     case Op::Not: return in[0];
     case Op::Select: return in[0] || in[1] || in[2];
-    case Op::PowI: return imm < 0 || in[0]; // 1 / 0^n is empty
+    case Op::PowI:
+        return imm < 0 || in[0]; // 1 / 0^n is empty
     // A divisor of known sign cannot be [0, 0].
     case Op::Div: return in[0] || !(divisor.lo_positive || divisor.hi_negative);
     // Outside the domain: empty.
@@ -230,7 +233,8 @@ Tables build_tables(const Tape& t, const ir::EvalOptions& o) {
                 for (std::size_t c = 0; c < chosen.size(); ++c) {
                     const Instr& ins = *chosen[c];
                     Interval args[3];
-                    for (int a = 0; a < ir::arity(ins.op); ++a) args[a] = box[ins.in[static_cast<std::size_t>(a)]];
+                    for (int a = 0; a < ir::arity(ins.op); ++a)
+                        args[a] = box[ins.in[static_cast<std::size_t>(a)]];
                     box[ins.out] = ir::apply_interval(ins.op, args, ins.imm);
                     out.index_tables[base + c].box[k] = box[ins.out];
                 }

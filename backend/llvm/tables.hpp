@@ -37,7 +37,7 @@ Facts facts_of(const Interval* values, std::size_t n);
 struct IndexTable {
     ir::Slot slot = ir::no_slot;
     std::uint32_t series = 0;
-    std::vector<Interval> box;  // entry k: index start + k
+    std::vector<Interval> box; // entry k: index start + k
     std::vector<double> point;
     Facts facts;
 };
@@ -60,8 +60,8 @@ struct SeriesTables {
 };
 
 struct Tables {
-    std::vector<SeriesTables> series;  // by tape series index
-    std::vector<int> slot_table;       // slot -> index into index_tables, or -1
+    std::vector<SeriesTables> series; // by tape series index
+    std::vector<int> slot_table;      // slot -> index into index_tables, or -1
     std::vector<IndexTable> index_tables;
     // What is known of every slot's interval value, given boxes without empty coordinates (the only
     // boxes the generated code sees): maybe_empty is a fixed point over the whole tape, orbit states

@@ -29,9 +29,10 @@ inline std::string describe(const jit::JitConfig& c) {
     return std::string(r) + " x" + std::to_string(c.lanes);
 }
 
-inline CrossCheckResult cross_check(const ir::Tape& tape, const std::vector<Interval>& range, std::uint64_t seed,
-                                    std::size_t count, const ir::EvalOptions& options = {},
-                                    bool with_empty = true, const jit::JitConfig& config = {}) {
+inline CrossCheckResult cross_check(const ir::Tape& tape, const std::vector<Interval>& range,
+                                    std::uint64_t seed, std::size_t count,
+                                    const ir::EvalOptions& options = {}, bool with_empty = true,
+                                    const jit::JitConfig& config = {}) {
     CrossCheckResult r;
     auto in = interp::make_interpreter(tape, options);
     auto jt = jit::make_jit(tape, options, config);
@@ -44,7 +45,8 @@ inline CrossCheckResult cross_check(const ir::Tape& tape, const std::vector<Inte
     };
     for (std::size_t n = 0; n < count; ++n) {
         std::vector<Interval> b = mk.box(range);
-        if (with_empty && d > 0 && mk.pick(64) == 0) b[static_cast<std::size_t>(mk.pick(d))] = Interval::empty();
+        if (with_empty && d > 0 && mk.pick(64) == 0)
+            b[static_cast<std::size_t>(mk.pick(d))] = Interval::empty();
         all.insert(all.end(), b.begin(), b.end());
         in->stats = {};
         jt->stats = {};
@@ -55,8 +57,8 @@ inline CrossCheckResult cross_check(const ir::Tape& tape, const std::vector<Inte
             ++r.box_mismatches;
             note("box " + hex_box(b.data(), d) + ": interp " + hex(ri) + ", jit " + hex(rj));
         }
-        if (in->stats.series_terms != jt->stats.series_terms || in->stats.series_capped != jt->stats.series_capped ||
-            in->stats.calls != jt->stats.calls) {
+        if (in->stats.series_terms != jt->stats.series_terms ||
+            in->stats.series_capped != jt->stats.series_capped || in->stats.calls != jt->stats.calls) {
             ++r.stat_mismatches;
             note("box " + hex_box(b.data(), d) + ": terms interp " + std::to_string(in->stats.series_terms) +
                  " jit " + std::to_string(jt->stats.series_terms) + ", capped " +
@@ -75,7 +77,8 @@ inline CrossCheckResult cross_check(const ir::Tape& tape, const std::vector<Inte
             for (double v : p) at += hex(v) + " ";
             note("point " + at + ": interp " + hex(pi) + ", jit " + hex(pj));
         }
-        if (in->stats.series_terms != jt->stats.series_terms || in->stats.series_capped != jt->stats.series_capped) {
+        if (in->stats.series_terms != jt->stats.series_terms ||
+            in->stats.series_capped != jt->stats.series_capped) {
             ++r.stat_mismatches;
             note("point: terms differ");
         }
@@ -91,8 +94,8 @@ inline CrossCheckResult cross_check(const ir::Tape& tape, const std::vector<Inte
             ++r.box_mismatches;
             note("batch box " + std::to_string(n) + ": interp " + hex(oi[n]) + ", jit " + hex(oj[n]));
         }
-    if (in->stats.series_terms != jt->stats.series_terms || in->stats.series_capped != jt->stats.series_capped ||
-        in->stats.calls != jt->stats.calls) {
+    if (in->stats.series_terms != jt->stats.series_terms ||
+        in->stats.series_capped != jt->stats.series_capped || in->stats.calls != jt->stats.calls) {
         ++r.stat_mismatches;
         note("batch: stats differ");
     }
@@ -108,8 +111,9 @@ inline CrossCheckResult cross_check(const ir::Tape& tape, const std::vector<Inte
 }
 
 // cross_check for every code generator variant (the box and point counts are split among them).
-inline CrossCheckResult cross_check_all(const ir::Tape& tape, const std::vector<Interval>& range, std::uint64_t seed,
-                                        std::size_t count, const ir::EvalOptions& options = {}) {
+inline CrossCheckResult cross_check_all(const ir::Tape& tape, const std::vector<Interval>& range,
+                                        std::uint64_t seed, std::size_t count,
+                                        const ir::EvalOptions& options = {}) {
     CrossCheckResult total;
     const auto configs = jit_configs();
     for (std::size_t k = 0; k < configs.size(); ++k) {
@@ -126,13 +130,13 @@ inline CrossCheckResult cross_check_all(const ir::Tape& tape, const std::vector<
     return total;
 }
 
-#define FRAC_REQUIRE_IDENTICAL(result)                                                                        \
-    do {                                                                                                      \
+#define FRAC_REQUIRE_IDENTICAL(result)                                                                       \
+    do {                                                                                                     \
         const auto& r_ = (result);                                                                           \
-        INFO(r_.first);                                                                                       \
-        CHECK(r_.box_mismatches == 0);                                                                        \
-        CHECK(r_.point_mismatches == 0);                                                                      \
-        CHECK(r_.stat_mismatches == 0);                                                                       \
+        INFO(r_.first);                                                                                      \
+        CHECK(r_.box_mismatches == 0);                                                                       \
+        CHECK(r_.point_mismatches == 0);                                                                     \
+        CHECK(r_.stat_mismatches == 0);                                                                      \
     } while (0)
 
 } // namespace frac::test

@@ -39,14 +39,18 @@ inline bool same(double a, double b) {
     if (std::isnan(a) && std::isnan(b)) return true;
     return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
 }
-inline bool same(Interval a, Interval b) { return same(a.lo, b.lo) && same(a.hi, b.hi); }
+inline bool same(Interval a, Interval b) {
+    return same(a.lo, b.lo) && same(a.hi, b.hi);
+}
 
 inline std::string hex(double v) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%a", v);
     return buf;
 }
-inline std::string hex(Interval v) { return "[" + hex(v.lo) + ", " + hex(v.hi) + "]"; }
+inline std::string hex(Interval v) {
+    return "[" + hex(v.lo) + ", " + hex(v.hi) + "]";
+}
 inline std::string hex_box(const Interval* b, int d) {
     std::string s;
     for (int k = 0; k < d; ++k) s += (k ? " x " : "") + hex(b[k]);
@@ -88,9 +92,9 @@ public:
     double position(Interval range) {
         const double span = range.hi - range.lo;
         switch (pick(8)) {
-        case 0: return range.lo + span * pick(9) / 8.0;          // dyadic points
-        case 1: return range.lo + span * pick(28) / 27.0;        // triadic points
-        case 2: return std::ldexp(uniform(-1, 1), -pick(60));    // near 0
+        case 0: return range.lo + span * pick(9) / 8.0;           // dyadic points
+        case 1: return range.lo + span * pick(28) / 27.0;         // triadic points
+        case 2: return std::ldexp(uniform(-1, 1), -pick(60));     // near 0
         case 3: return uniform(range.lo - span, range.hi + span); // beyond the default box
         default: return uniform(range.lo, range.hi);
         }
@@ -98,8 +102,8 @@ public:
     Interval coordinate(Interval range) {
         const double c = position(range);
         switch (pick(12)) {
-        case 0: return Interval(c);                                       // thin
-        case 1: return {c, c + std::ldexp(1.0, -pick(50))};              // tiny
+        case 0: return Interval(c);                                                    // thin
+        case 1: return {c, c + std::ldexp(1.0, -pick(50))};                            // tiny
         case 2: return {c - std::ldexp(1.0, pick(40)), c + std::ldexp(1.0, pick(40))}; // huge
         case 3: return pick(2) ? Interval{-num::inf, c} : Interval{c, num::inf};
         case 4: return {-std::ldexp(1.0, -pick(30)), std::ldexp(1.0, -pick(30))}; // around 0

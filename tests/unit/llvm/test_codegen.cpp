@@ -37,13 +37,16 @@ std::size_t count_lines(const std::string& text, const std::function<bool(const 
     return n;
 }
 
-bool has(const std::string& line, const char* what) { return line.find(what) != std::string::npos; }
+bool has(const std::string& line, const char* what) {
+    return line.find(what) != std::string::npos;
+}
 
 } // namespace
 
 TEST_CASE("interval code rounds upward in every operation, never fast-math", "[llvm][codegen]") {
     using R = jit::JitConfig::Rounding;
-    const Model m = compile("import \"fractals\"; shape g(x, y) = x / y + sqrt(x) * sin(y) - x^3 + mod(x, 1);");
+    const Model m =
+        compile("import \"fractals\"; shape g(x, y) = x / y + sqrt(x) * sin(y) - x^3 + mod(x, 1);");
     std::vector<jit::JitConfig> configs = {{R::constrained, 1}, {R::constrained, 4}};
     if (jit::host_has_avx512()) configs.insert(configs.end(), {{R::avx512, 1}, {R::avx512, 8}});
     // (Integer-to-double conversions of series indices below 2^53 are exact: allowed as plain IR in the
@@ -72,11 +75,12 @@ TEST_CASE("interval code rounds upward in every operation, never fast-math", "[l
                     // strictfp, and every constrained operation says round.upward.
                     CHECK(strictfp);
                     const auto ops = count_lines(box, [](const std::string& l) {
-                        return has(l, "call") && has(l, "@llvm.experimental.constrained.") && !has(l, ".fcmp") &&
-                               !has(l, ".floor") && !has(l, ".ceil");
+                        return has(l, "call") && has(l, "@llvm.experimental.constrained.") &&
+                               !has(l, ".fcmp") && !has(l, ".floor") && !has(l, ".ceil");
                     });
                     const auto upward = count_lines(box, [](const std::string& l) {
-                        return has(l, "call") && has(l, "@llvm.experimental.constrained.") && has(l, "!\"round.upward\"");
+                        return has(l, "call") && has(l, "@llvm.experimental.constrained.") &&
+                               has(l, "!\"round.upward\"");
                     });
                     CHECK(ops > 0);
                     CHECK(upward == ops);

@@ -55,7 +55,8 @@ TEMPLATE_TEST_CASE("plain expressions on points and boxes", "[llvm][conformance]
     CHECK(s.contains(0.30000000000000004));
 }
 
-TEMPLATE_TEST_CASE("rounding is set by the evaluator and restored", "[llvm][conformance]", InterpEngine, JitEngine) {
+TEMPLATE_TEST_CASE("rounding is set by the evaluator and restored", "[llvm][conformance]", InterpEngine,
+                   JitEngine) {
     const Model m = compile("shape s(x, y) = x / 3 + y * 0.1;");
     auto e = TestType::make(m.tapes[0]);
     REQUIRE(std::fegetround() == FE_TONEAREST);
@@ -70,8 +71,8 @@ TEMPLATE_TEST_CASE("rounding is set by the evaluator and restored", "[llvm][conf
     CHECK(same(r, r2));
 }
 
-TEMPLATE_TEST_CASE("Takagi series: point value and proven enclosure", "[llvm][conformance][series]", InterpEngine,
-                   JitEngine) {
+TEMPLATE_TEST_CASE("Takagi series: point value and proven enclosure", "[llvm][conformance][series]",
+                   InterpEngine, JitEngine) {
     const Model m = compile("shape s(x, y) = y - sum(i in 0.., dz(2^i * x) / 2^i);");
     auto e = TestType::make(m.tapes[0]);
     for (double x : {0.1, 0.3, 1.0 / 3.0, 0.77}) {
@@ -117,16 +118,18 @@ TEMPLATE_TEST_CASE("the term limit caps a series and is counted", "[llvm][confor
     CHECK_THROWS_AS(TestType::make(m.tapes[0], ir::EvalOptions{0, true}), std::invalid_argument);
 }
 
-TEMPLATE_TEST_CASE("orbit series update the point simultaneously", "[llvm][conformance][series]", InterpEngine,
-                   JitEngine) {
+TEMPLATE_TEST_CASE("orbit series update the point simultaneously", "[llvm][conformance][series]",
+                   InterpEngine, JitEngine) {
     // p0 = (x, y), p1 = swap(p0) = (y, x): the sum of p.y over both is y + x.
-    const Model m = compile("fn swap(p) = (p.y, p.x); shape s(x, y) = sum(k in 0..1, p in orbit((x, y), swap), p.y);");
+    const Model m =
+        compile("fn swap(p) = (p.y, p.x); shape s(x, y) = sum(k in 0..1, p in orbit((x, y), swap), p.y);");
     auto e = TestType::make(m.tapes[0]);
     CHECK(point2(*e, 0.25, 0.5) == 0.75);
     CHECK(same(box2(*e, Interval(0.25), Interval(0.5)), Interval(0.75)));
 }
 
-TEMPLATE_TEST_CASE("empty coordinates give empty enclosures", "[llvm][conformance]", InterpEngine, JitEngine) {
+TEMPLATE_TEST_CASE("empty coordinates give empty enclosures", "[llvm][conformance]", InterpEngine,
+                   JitEngine) {
     const Model m = compile("import \"fractals\"; shape d(x, y) = sqrt(x) + y;");
     auto carpet = shape_eval<TestType>(m, "carpet");
     CHECK(box2(*carpet, Interval::empty(), {0, 1}).is_empty());
@@ -138,8 +141,8 @@ TEMPLATE_TEST_CASE("empty coordinates give empty enclosures", "[llvm][conformanc
     CHECK(r.hi >= 3);
 }
 
-TEMPLATE_TEST_CASE("batches equal single evaluations; clones are independent", "[llvm][conformance]", InterpEngine,
-                   JitEngine) {
+TEMPLATE_TEST_CASE("batches equal single evaluations; clones are independent", "[llvm][conformance]",
+                   InterpEngine, JitEngine) {
     const Model m = compile("import \"fractals\";");
     auto e = shape_eval<TestType>(m, "triangle_stripes");
     BoxMaker mk(3);
@@ -165,7 +168,8 @@ TEMPLATE_TEST_CASE("batches equal single evaluations; clones are independent", "
         c->stats = {};
         CHECK(same(c->eval_box(&boxes[2 * static_cast<std::size_t>(n)]), batch[static_cast<std::size_t>(n)]));
         single_terms += c->stats.series_terms;
-        CHECK(same(c->eval_point(&points[2 * static_cast<std::size_t>(n)]), pbatch[static_cast<std::size_t>(n)]));
+        CHECK(same(c->eval_point(&points[2 * static_cast<std::size_t>(n)]),
+                   pbatch[static_cast<std::size_t>(n)]));
     }
     CHECK(single_terms == terms);
     e.reset(); // the clone keeps working without its original

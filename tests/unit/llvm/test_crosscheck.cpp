@@ -11,7 +11,9 @@ using namespace frac::test;
 
 namespace {
 
-std::vector<Interval> default_range(int d) { return std::vector<Interval>(static_cast<std::size_t>(d), {-2, 2}); }
+std::vector<Interval> default_range(int d) {
+    return std::vector<Interval>(static_cast<std::size_t>(d), {-2, 2});
+}
 
 } // namespace
 
@@ -49,21 +51,68 @@ TEST_CASE("an expression for every opcode agrees", "[llvm][crosscheck]") {
     // Each line is a shape over x, y; together they use every arithmetic and logic opcode, with
     // operands of every sign (the default range is [-2, 2] and BoxMaker goes beyond it).
     const char* exprs[] = {
-        "x + y", "x - y", "x * y", "x / y", "1 / x", "-x", "x^2", "x^3", "x^4", "x^-1", "x^-2", "x^0 + y",
-        "x^y", "abs(x)^y", "x^0.5", "pow(abs(x), 1/3)", "sqrt(x)", "sqrt(x^2 + y^2)", "abs(x - y)", "min(x, y)",
-        "max(x, y)", "min(x, 1, y)", "floor(x * 3)", "ceil(y / 3)", "mod(x, 1)", "mod(3 * x, 1) - y", "dz(x)",
-        "dz(5 * x + y)", "sin(x)", "cos(3 * y)", "tan(x)", "exp(x)", "log(x)", "log(abs(x) + y)", "atan2(y, x)",
-        "if x < y then x else y", "if x <= y then x * x else -y", "if x > 0 then 1 else -1",
-        "if x >= y and y > 0 then x else y", "if x == y then 1 else 0", "if x != 0.5 or y < 0 then x else 2",
-        "if not (x < y) then x else y + 1", "if x < 0 then sqrt(x) else log(y)", "x / (y - y)", "x / 0",
-        "(x - 1) / (y * y)", "x * 0", "0 * log(x)", "sqrt(-1 - x * x)", "x^(-3) + y^6", "x * y * x - y^5",
-        "[0.1, 0.2] * x + [-1, 1] / y", "exp(x * 800) - exp(y)", "1e300 * x * x + y", "-x^2 + dz(x * 1e17)",
+        "x + y",
+        "x - y",
+        "x * y",
+        "x / y",
+        "1 / x",
+        "-x",
+        "x^2",
+        "x^3",
+        "x^4",
+        "x^-1",
+        "x^-2",
+        "x^0 + y",
+        "x^y",
+        "abs(x)^y",
+        "x^0.5",
+        "pow(abs(x), 1/3)",
+        "sqrt(x)",
+        "sqrt(x^2 + y^2)",
+        "abs(x - y)",
+        "min(x, y)",
+        "max(x, y)",
+        "min(x, 1, y)",
+        "floor(x * 3)",
+        "ceil(y / 3)",
+        "mod(x, 1)",
+        "mod(3 * x, 1) - y",
+        "dz(x)",
+        "dz(5 * x + y)",
+        "sin(x)",
+        "cos(3 * y)",
+        "tan(x)",
+        "exp(x)",
+        "log(x)",
+        "log(abs(x) + y)",
+        "atan2(y, x)",
+        "if x < y then x else y",
+        "if x <= y then x * x else -y",
+        "if x > 0 then 1 else -1",
+        "if x >= y and y > 0 then x else y",
+        "if x == y then 1 else 0",
+        "if x != 0.5 or y < 0 then x else 2",
+        "if not (x < y) then x else y + 1",
+        "if x < 0 then sqrt(x) else log(y)",
+        "x / (y - y)",
+        "x / 0",
+        "(x - 1) / (y * y)",
+        "x * 0",
+        "0 * log(x)",
+        "sqrt(-1 - x * x)",
+        "x^(-3) + y^6",
+        "x * y * x - y^5",
+        "[0.1, 0.2] * x + [-1, 1] / y",
+        "exp(x * 800) - exp(y)",
+        "1e300 * x * x + y",
+        "-x^2 + dz(x * 1e17)",
     };
     int k = 0;
     for (const char* e : exprs) {
         const Model m = compile(std::string("shape s(x, y) = ") + e + ";");
         INFO(e);
-        FRAC_REQUIRE_IDENTICAL(cross_check_all(m.tapes[0], default_range(2), 500 + static_cast<std::uint64_t>(k++), 400));
+        FRAC_REQUIRE_IDENTICAL(
+            cross_check_all(m.tapes[0], default_range(2), 500 + static_cast<std::uint64_t>(k++), 400));
     }
 }
 
@@ -102,10 +151,12 @@ TEST_CASE("series of every kind agree: finite, infinite, with B, nested, orbits"
             continue;
         }
         const ir::Tape t = ir::build_tape(c->module.graph, c->module.shapes[0].root, 2);
-        FRAC_REQUIRE_IDENTICAL(cross_check_all(t, {{0, 1}, {0, 1}}, 900 + static_cast<std::uint64_t>(k), 600));
+        FRAC_REQUIRE_IDENTICAL(
+            cross_check_all(t, {{0, 1}, {0, 1}}, 900 + static_cast<std::uint64_t>(k), 600));
         ir::EvalOptions o;
         o.max_terms = 4;
-        FRAC_REQUIRE_IDENTICAL(cross_check_all(t, {{-1, 1}, {-1, 1}}, 950 + static_cast<std::uint64_t>(k++), 200, o));
+        FRAC_REQUIRE_IDENTICAL(
+            cross_check_all(t, {{-1, 1}, {-1, 1}}, 950 + static_cast<std::uint64_t>(k++), 200, o));
     }
 }
 
@@ -119,7 +170,8 @@ ir::NodeId random_node(ir::Graph& g, BoxMaker& mk, int depth) {
         case 0: return g.var(0);
         case 1: return g.var(1);
         case 2: {
-            const double vals[] = {0.0, -0.0, 1.0, -1.0, 0.5, 3.0, 1e-310, 1e300, num::inf, -num::inf, 0.1, 2.75};
+            const double vals[] = {0.0,    -0.0,  1.0,      -1.0,      0.5, 3.0,
+                                   1e-310, 1e300, num::inf, -num::inf, 0.1, 2.75};
             return g.constant(vals[mk.pick(12)]);
         }
         case 3: return g.constant(Interval{-mk.uniform(0, 2), mk.uniform(0, 2)}, 0.0);
@@ -127,10 +179,10 @@ ir::NodeId random_node(ir::Graph& g, BoxMaker& mk, int depth) {
         default: return g.var(mk.pick(2));
         }
     }
-    static const Op ops[] = {Op::Add,   Op::Sub,  Op::Mul,  Op::Div,   Op::Neg,  Op::Sqr, Op::PowI, Op::Pow,
-                             Op::Sqrt,  Op::Abs,  Op::Min,  Op::Max,   Op::Floor, Op::Ceil, Op::Mod1, Op::Dz,
-                             Op::Sin,   Op::Cos,  Op::Tan,  Op::Exp,   Op::Log,  Op::Atan2, Op::Lt,  Op::Le,
-                             Op::Gt,    Op::Ge,   Op::Eq,   Op::Ne,    Op::And,  Op::Or,  Op::Not,  Op::Select};
+    static const Op ops[] = {Op::Add,  Op::Sub, Op::Mul, Op::Div, Op::Neg,   Op::Sqr,   Op::PowI, Op::Pow,
+                             Op::Sqrt, Op::Abs, Op::Min, Op::Max, Op::Floor, Op::Ceil,  Op::Mod1, Op::Dz,
+                             Op::Sin,  Op::Cos, Op::Tan, Op::Exp, Op::Log,   Op::Atan2, Op::Lt,   Op::Le,
+                             Op::Gt,   Op::Ge,  Op::Eq,  Op::Ne,  Op::And,   Op::Or,    Op::Not,  Op::Select};
     const Op op = ops[mk.pick(static_cast<int>(std::size(ops)))];
     const int n = ir::arity(op);
     ir::NodeId a[3] = {ir::no_node, ir::no_node, ir::no_node};
@@ -148,7 +200,8 @@ TEST_CASE("random expression graphs agree", "[llvm][crosscheck]") {
         const ir::NodeId root = random_node(g, mk, 5);
         const ir::Tape t = ir::build_tape(g, root, 2);
         INFO("graph " << n << ":\n" << ir::print_tape(t));
-        FRAC_REQUIRE_IDENTICAL(cross_check_all(t, default_range(2), 7000 + static_cast<std::uint64_t>(n), 60));
+        FRAC_REQUIRE_IDENTICAL(
+            cross_check_all(t, default_range(2), 7000 + static_cast<std::uint64_t>(n), 60));
     }
 }
 

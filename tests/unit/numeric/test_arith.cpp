@@ -6,7 +6,6 @@
 #include <stdexcept>
 #include <vector>
 
-
 TEST_CASE("UpwardRounding sets upward rounding and restores the previous mode", "[numeric][rounding]") {
     REQUIRE(std::fegetround() == FE_TONEAREST);
     REQUIRE_FALSE(num::rounding_is_upward());
