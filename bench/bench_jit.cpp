@@ -6,6 +6,7 @@
 //   bench_jit [depth=10] [large_depth=12] [json=bench_jit.json] [depth_3d=6]
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/jit.hpp"
+#include "bench/bench_common.hpp"
 #include "bench/carpet_handwritten.hpp"
 #include "frontend/driver.hpp"
 #include "ir/tape.hpp"
@@ -22,17 +23,9 @@ using namespace frac;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-    return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-struct Shape {
-    std::string name;
-    int dimension;
-    std::vector<ir::Interval> box;
-    ir::Tape tape;
-};
+using bench::Clock;
+using bench::seconds_since;
+using bench::Shape;
 
 struct Cover {
     std::uint64_t boxes = 0, terms = 0, boundary = 0;

@@ -10,6 +10,7 @@
 //   bench_prune [depth=10] [json=bench_prune.json] [depth_3d=7]
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/jit.hpp"
+#include "bench/bench_common.hpp"
 #include "frontend/driver.hpp"
 #include "ir/specialize.hpp"
 #include "ir/tape.hpp"
@@ -27,17 +28,9 @@ using namespace frac;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-    return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-struct Shape {
-    std::string name;
-    int dimension;
-    std::vector<ir::Interval> box;
-    ir::Tape tape;
-};
+using bench::Clock;
+using bench::seconds_since;
+using bench::Shape;
 
 // The named shape of a model file (relative to the source tree) or of a stdlib module.
 Shape load(const std::string& source, const std::string& name, bool is_file) {

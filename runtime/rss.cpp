@@ -1,5 +1,6 @@
 #include "runtime/rss.hpp"
 
+#include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
 #include <thread>
@@ -202,13 +203,22 @@ private:
         const auto d = static_cast<std::size_t>(d_);
         boxes_.resize(m * d);
         out_.resize(m);
-        {
+        const auto cell_boxes = [&](std::size_t begin, std::size_t end) {
             num::UpwardRounding up; // the cell boxes use the numeric core's directed rounding
-            for (std::size_t j = 0; j < m; ++j) {
+            for (std::size_t j = begin; j < end; ++j) {
                 const std::uint32_t pos[3] = {queue_[j].ix, queue_[j].iy, queue_[j].iz};
                 for (std::size_t a = 0; a < d; ++a)
                     boxes_[j * d + a] = cell_axis(r_.root[a], width_[a], pos[a], n_);
             }
+        };
+        if (threads_ == 1 || m < 2 * min_chunk) {
+            cell_boxes(0, m);
+        } else {
+            arena_.execute([&] {
+                tbb::parallel_for(
+                    tbb::blocked_range<std::size_t>(0, m, min_chunk),
+                    [&](const tbb::blocked_range<std::size_t>& r) { cell_boxes(r.begin(), r.end()); });
+            });
         }
         evaluate(m);
 
@@ -252,9 +262,8 @@ private:
     }
 
     // Evaluates boxes_[0, m) into out_, each cell with its variant's function: the cells are gathered
-    // by variant, each variant's run is cut into at most one chunk per thread (chunk c of a variant
-    // uses that variant's evaluator c), all chunks run in one parallel loop, and the results are put
-    // back in place.
+    // by variant, each variant's run is cut into up to chunks_per_thread chunks per thread, all
+    // chunks run in one parallel loop, and the results are put back in place.
     void evaluate(std::size_t m) {
         const auto d = static_cast<std::size_t>(d_);
         bool mixed = false;
@@ -283,29 +292,38 @@ private:
             out = group_out_.data();
         }
         struct Chunk {
-            std::uint32_t variant, worker;
+            std::uint32_t variant;
             std::size_t begin, end;
         };
         std::vector<Chunk> chunks;
         for (std::size_t r = 0; r < run_variant.size(); ++r) {
             const std::size_t n = starts[r + 1] - starts[r];
             if (run_variant[r] != 0) r_.pruned_evaluations += n;
-            const auto k = std::max<std::size_t>(1, std::min<std::size_t>(static_cast<std::size_t>(threads_),
-                                                                          (n + min_chunk - 1) / min_chunk));
+            const auto k = std::max<std::size_t>(
+                1, std::min<std::size_t>(
+                       threads_ == 1 ? 1 : chunks_per_thread * static_cast<std::size_t>(threads_),
+                       (n + min_chunk - 1) / min_chunk));
             for (std::size_t c = 0; c < k; ++c)
-                chunks.push_back({run_variant[r], static_cast<std::uint32_t>(c), starts[r] + n * c / k,
-                                  starts[r] + n * (c + 1) / k});
+                chunks.push_back({run_variant[r], starts[r] + n * c / k, starts[r] + n * (c + 1) / k});
         }
-        const auto run_chunk = [&](const Chunk& c) {
-            variants_[c.variant].workers[c.worker]->eval_boxes(boxes + c.begin * d, c.end - c.begin,
-                                                               out + c.begin);
+        // A chunk runs on the evaluator of the thread that takes it (its slot in the arena), so no two
+        // threads share an evaluator, and threads that finish early take more chunks (series stop
+        // after different numbers of terms in different cells). Results go by position, so the
+        // output does not depend on which thread evaluated what.
+        const auto run_chunk = [&](const Chunk& c, std::size_t worker) {
+            variants_[c.variant].workers[worker]->eval_boxes(boxes + c.begin * d, c.end - c.begin,
+                                                             out + c.begin);
         };
         if (chunks.size() == 1 || threads_ == 1) {
-            for (const Chunk& c : chunks) run_chunk(c);
+            for (const Chunk& c : chunks) run_chunk(c, 0);
         } else {
             arena_.execute([&] {
-                tbb::parallel_for(std::size_t{0}, chunks.size(),
-                                  [&](std::size_t i) { run_chunk(chunks[i]); });
+                tbb::parallel_for(std::size_t{0}, chunks.size(), [&](std::size_t i) {
+                    const int slot = tbb::this_task_arena::current_thread_index();
+                    if (slot < 0 || slot >= threads_)
+                        throw std::logic_error("rss: a thread outside the subdivision's arena");
+                    run_chunk(chunks[i], static_cast<std::size_t>(slot));
+                });
             });
         }
         if (mixed)
@@ -341,7 +359,8 @@ private:
         return it->second;
     }
 
-    static constexpr std::size_t min_chunk = 256; // below this a thread costs more than it saves
+    static constexpr std::size_t min_chunk = 256;       // below this a thread costs more than it saves
+    static constexpr std::size_t chunks_per_thread = 8; // dynamic balance between threads
     ir::Evaluator& f_;
     RssResult& r_;
     int d_;
