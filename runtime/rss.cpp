@@ -158,6 +158,23 @@ private:
     void start_level(int k) {
         level_ = k;
         n_ = ipow(r_.options.split, k);
+        // The level's grid points per axis, computed once (each cell would otherwise compute two per
+        // axis with three interval operations each); the same expression, so the same boxes.
+        grid_.assign(n_ <= grid_table_limit ? static_cast<std::size_t>(d_) : 0, {});
+        if (grid_.empty()) return;
+        num::UpwardRounding up;
+        for (std::size_t a = 0; a < grid_.size(); ++a) {
+            grid_[a].resize(n_ + 1);
+            for (std::uint64_t j = 0; j <= n_; ++j) grid_[a][j] = grid_point(r_.root[a], width_[a], j, n_);
+        }
+    }
+
+    // Outward box of cell i of the level along `axis` (cell_axis, from the level's table when it has one).
+    Interval cell_interval(std::size_t axis, std::uint32_t i) const {
+        if (grid_.empty()) return cell_axis(r_.root[axis], width_[axis], i, n_);
+        const Interval root = r_.root[axis];
+        return {i == 0 ? root.lo : std::max(root.lo, grid_[axis][i].lo),
+                i + 1 >= n_ ? root.hi : std::min(root.hi, grid_[axis][i + 1].hi)};
     }
 
     void finish_level() {
@@ -207,8 +224,7 @@ private:
             num::UpwardRounding up; // the cell boxes use the numeric core's directed rounding
             for (std::size_t j = begin; j < end; ++j) {
                 const std::uint32_t pos[3] = {queue_[j].ix, queue_[j].iy, queue_[j].iz};
-                for (std::size_t a = 0; a < d; ++a)
-                    boxes_[j * d + a] = cell_axis(r_.root[a], width_[a], pos[a], n_);
+                for (std::size_t a = 0; a < d; ++a) boxes_[j * d + a] = cell_interval(a, pos[a]);
             }
         };
         if (threads_ == 1 || m < 2 * min_chunk) {
@@ -359,8 +375,9 @@ private:
         return it->second;
     }
 
-    static constexpr std::size_t min_chunk = 256;       // below this a thread costs more than it saves
-    static constexpr std::size_t chunks_per_thread = 8; // dynamic balance between threads
+    static constexpr std::size_t min_chunk = 256;              // below this a thread costs more than it saves
+    static constexpr std::uint64_t grid_table_limit = 1 << 16; // cells per axis with a table of grid points
+    static constexpr std::size_t chunks_per_thread = 8;        // dynamic balance between threads
     ir::Evaluator& f_;
     RssResult& r_;
     int d_;
@@ -380,11 +397,12 @@ private:
     std::vector<std::size_t> order_;                // ... their positions in the batch
     std::size_t flush_at_ = 0;
     int level_ = 0;
-    std::uint64_t n_ = 1;               // cells per axis at level_
-    std::vector<Interval> width_;       // enclosure of the root's width per axis
-    std::vector<Pos> queue_;            // cells of level_ waiting for evaluation
-    std::vector<Interval> boxes_, out_; // batch buffers
-    std::vector<Pos> next_;             // undecided cells of level_, row-major
+    std::uint64_t n_ = 1;                     // cells per axis at level_
+    std::vector<std::vector<Interval>> grid_; // grid points of the level per axis, when n_ <= limit
+    std::vector<Interval> width_;             // enclosure of the root's width per axis
+    std::vector<Pos> queue_;                  // cells of level_ waiting for evaluation
+    std::vector<Interval> boxes_, out_;       // batch buffers
+    std::vector<Pos> next_;                   // undecided cells of level_, row-major
     Clock::time_point last_progress_;
 };
 
