@@ -256,6 +256,40 @@ TEST_CASE("rss: deterministic, with or without cells", "[rss]") {
     CHECK(same_cells(a, d));
 }
 
+// The vertical line x = c; records every box it is asked about, in order.
+class RecordingLine : public test::TestShape {
+public:
+    explicit RecordingLine(double c) : TestShape(2), c(c) {}
+    double eval_point(const double* p) override { return p[0] - c; }
+    Interval eval_box(const Interval* b) override {
+        seen.push_back(b[0]);
+        seen.push_back(b[1]);
+        num::UpwardRounding up;
+        return num::sub(b[0], Interval(c));
+    }
+    std::unique_ptr<ir::Evaluator> clone() const override { return std::make_unique<RecordingLine>(*this); }
+
+    double c;
+    std::vector<Interval> seen;
+};
+
+TEST_CASE("rss: the boxes evaluated are the cells' boxes, with and without the grid-point table", "[rss]") {
+    // Split 3 (1/3 is not a binary number): levels up to 10 have at most 3^10 < 2^16 cells per axis and
+    // use the table of grid points; level 11 computes each cell's box directly.
+    RecordingLine line(0.3);
+    const RssResult r = subdivide(line, square, opts(11, 3));
+    REQUIRE(line.seen.size() == 2 * r.cells.size());
+    REQUIRE(r.levels[11].evaluated > 0);
+    std::size_t mismatches = 0;
+    for (std::size_t i = 0; i < r.cells.size(); ++i)
+        for (int a = 0; a < 2; ++a) {
+            const Interval want = r.cell_interval(r.cells[i], a);
+            const Interval got = line.seen[2 * i + static_cast<std::size_t>(a)];
+            if (!(got.lo == want.lo && got.hi == want.hi)) ++mismatches;
+        }
+    CHECK(mismatches == 0);
+}
+
 TEST_CASE("rss: evaluates level by level in batches", "[rss]") {
     Disk disk(0, 0, 0.75);
     RssOptions o = opts(6);
