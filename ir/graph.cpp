@@ -1,5 +1,6 @@
 #include "ir/graph.hpp"
 
+#include "ir/point_bounds.hpp"
 #include "ir/semantics.hpp"
 
 #include <bit>
@@ -85,6 +86,8 @@ NodeId Graph::intern(const Node& n) {
     for (NodeId a : n.args)
         if (a != no_node) stored.index_mask |= nodes_[a].index_mask;
     for (NodeId a : n.orbit) stored.index_mask |= nodes_[a].index_mask;
+    for (NodeId a : n.point_tail)
+        if (a != no_node) stored.index_mask |= nodes_[a].index_mask;
     if (n.op == Op::Index) stored.index_mask = std::uint64_t{1} << n.imm;
     if (n.op == Op::State) stored.index_mask = std::uint64_t{1} << (n.imm / 8);
     if (is_series(n.op)) stored.index_mask &= ~(std::uint64_t{1} << n.series.level);
@@ -182,6 +185,17 @@ NodeId Graph::series(Op kind, const SeriesData& data, NodeId body, NodeId tail_a
     n.series = data;
     n.orbit = std::move(orbit);
     n.args = {body, tail_a, tail_b};
+    // Bounds for point evaluation; a function of tail_a and tail_b, so not part of the node's key.
+    if (tail_a != no_node) {
+        const PointBounds a = point_bounds(*this, tail_a);
+        n.point_tail[0] = a.lo;
+        n.point_tail[1] = a.hi;
+    }
+    if (tail_b != no_node) {
+        const PointBounds b = point_bounds(*this, tail_b);
+        n.point_tail[2] = b.lo;
+        n.point_tail[3] = b.hi;
+    }
     return intern(n);
 }
 

@@ -79,6 +79,9 @@ struct Node {
     SeriesData series;        // series ops only
     // Orbit series: the initial point's components, then the map's components (of State nodes).
     std::vector<NodeId> orbit;
+    // Infinite series: nodes whose point values bound A and B (ir/point_bounds.hpp): lo A, hi A, lo B,
+    // hi B (no_node without B). Made by Graph::series from the tail coefficients.
+    std::array<NodeId, 4> point_tail{no_node, no_node, no_node, no_node};
     // Bit L set when the node depends on the index of series level L (L >= 1); bit 0 unused.
     std::uint64_t index_mask = 0;
 };

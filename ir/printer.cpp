@@ -27,6 +27,8 @@ std::string print_graph(const Graph& g, const std::vector<NodeId>& roots) {
         for (NodeId a : g[id].args)
             if (a != no_node) stack.push_back(a);
         for (NodeId a : g[id].orbit) stack.push_back(a);
+        for (NodeId a : g[id].point_tail)
+            if (a != no_node) stack.push_back(a);
     }
     std::string out;
     for (NodeId id = 0; id < g.size(); ++id) {
@@ -56,6 +58,12 @@ std::string print_graph(const Graph& g, const std::vector<NodeId>& roots) {
             if (s.end == infinite_end) {
                 const std::string b = n.args[2] == no_node ? "0" : fmt::format("%{}", n.args[2]);
                 out += fmt::format(" tail (%{} + {} i) * [{}, {}]^i", n.args[1], b, s.gamma.lo, s.gamma.hi);
+                for (int k = 0; k < 2; ++k) {
+                    const auto lo = n.point_tail[static_cast<std::size_t>(2 * k)];
+                    const auto hi = n.point_tail[static_cast<std::size_t>(2 * k + 1)];
+                    if (lo != n.args[static_cast<std::size_t>(1 + k)] || hi != lo)
+                        out += fmt::format(" point {} in [%{}, %{}]", k ? "B" : "A", lo, hi);
+                }
             }
             if (s.state_count > 0) {
                 std::string from, map;

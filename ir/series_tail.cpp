@@ -152,6 +152,36 @@ bool escape_point_done(Op kind, const OrbitEscape& e, double acc, const double* 
     return kind == Op::SeriesMax ? -bound <= acc + slack : bound >= acc - slack;
 }
 
+void compensated_add(double& acc, double& comp, double term) {
+    const double t = acc + term;
+    // The low-order bits the rounded sum lost; none to keep once the sum is not finite.
+    if (std::isfinite(t)) comp += std::fabs(acc) >= std::fabs(term) ? (acc - t) + term : (term - t) + acc;
+    acc = t;
+}
+
+double point_magnitude(double lo, double hi) {
+    if (std::isnan(lo) || std::isnan(hi)) return inf;
+    return std::fmax(std::fabs(lo), std::fabs(hi));
+}
+
+double series_point_end(Op kind, double acc, double comp, double a_lo, double a_hi, double b_lo, double b_hi,
+                        bool has_b, Interval gamma, std::int64_t n) {
+    if (std::isnan(a_lo) || std::isnan(a_hi) || (has_b && (std::isnan(b_lo) || std::isnan(b_hi))))
+        return acc + comp;
+    // Bounds rounded to nearest may cross by an ulp: order them.
+    const Interval a{std::fmin(a_lo, a_hi), std::fmax(a_lo, a_hi)};
+    const Interval b = has_b ? Interval{std::fmin(b_lo, b_hi), std::fmax(b_lo, b_hi)} : Interval(0.0);
+    Interval tail;
+    {
+        num::UpwardRounding up;
+        tail = series_tail(kind, a, b, has_b, gamma, n);
+    }
+    // A tail unbounded on one side tells nothing about the value: keep the partial result.
+    if (!std::isfinite(tail.lo) || !std::isfinite(tail.hi)) return acc + comp;
+    if (kind == Op::SeriesSum) return acc + (comp + num::midpoint(tail));
+    return series_combine_point(kind, acc, num::midpoint(tail));
+}
+
 Interval series_combine(Op kind, Interval acc, Interval term) {
     switch (kind) {
     case Op::SeriesSum: return add(acc, term);

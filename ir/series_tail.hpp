@@ -45,6 +45,18 @@ Interval lipschitz_finish(Op kind, const OrbitEscape& e, Interval acc, Interval 
 bool escape_point_done(Op kind, const OrbitEscape& e, double acc, const double* state, int dims,
                        std::int64_t n);
 
+// Point evaluation of a series (round to nearest). A sum is accumulated with Neumaier's compensated
+// summation (`compensated_add`: `acc` plus the rounding error `comp` it lost), so that its value is
+// within about an ulp of the exact sum however many terms it takes; an enclosure of the same point is
+// that tight too, and a point value off by several ulps would lie outside it. `point_magnitude` is
+// max(|lo|, |hi|) of the bounds of A or B at the point (TapeSeries::point_tail), +inf when one is NaN
+// or missing. `series_point_end` is the value after the terms up to index n: acc + comp plus the
+// midpoint of the tail's enclosure, or without it when the tail is unbounded.
+void compensated_add(double& acc, double& comp, double term);
+double point_magnitude(double lo, double hi);
+double series_point_end(Op kind, double acc, double comp, double a_lo, double a_hi, double b_lo, double b_hi,
+                        bool has_b, Interval gamma, std::int64_t n);
+
 // Combines a partial result with one more term (or with a tail).
 Interval series_combine(Op kind, Interval acc, Interval term);
 double series_combine_point(Op kind, double acc, double term);

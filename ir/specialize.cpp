@@ -302,6 +302,7 @@ private:
         for (Slot u : s.update_slots) n.update_slots.push_back(get(u));
         n.tail_a = get(s.tail_a);
         n.tail_b = get(s.tail_b);
+        // A specialised tape serves boxes: the point bounds of the tail (point-only code) are dropped.
         out.series.push_back(n);
         return static_cast<std::uint32_t>(out.series.size() - 1);
     }
@@ -370,6 +371,8 @@ std::string tape_key(const Tape& t) {
         put(s, ser.body_slot);
         put(s, ser.tail_a);
         put(s, ser.tail_b);
+        put(s, ser.point_block);
+        for (Slot x : ser.point_tail) put(s, x);
         for (const auto* v : {&ser.state_slots, &ser.init_slots, &ser.update_slots}) {
             put(s, v->size());
             for (Slot x : *v) put(s, x);

@@ -58,6 +58,7 @@ private:
         }
         Context& ctx = context_for(highest_level(n.index_mask));
         if (auto it = ctx.memo.find(id); it != ctx.memo.end()) return it->second;
+        if (capture_) return emit_captured(id);
         if (n.op == Op::Index) {
             // The index slot is allocated by the series that owns this context.
             throw std::logic_error("tape: series index without its series");
@@ -104,6 +105,7 @@ private:
         for (std::size_t c = 0; c < states; ++c) s.init_slots.push_back(emit(n.orbit[c]));
         if (n.args[1] != no_node) s.tail_a = emit(n.args[1]);
         if (n.args[2] != no_node) s.tail_b = emit(n.args[2]);
+        if (n.args[1] != no_node) emit_point_bounds(n, s);
         Instr ins;
         ins.op = n.op;
         ins.series = static_cast<std::uint32_t>(t_.series.size());
@@ -111,6 +113,37 @@ private:
         t_.series.push_back(s);
         t_.blocks[outer_block].push_back(ins);
         return ins.out;
+    }
+
+    // Point-only code of a series (TapeSeries::point_block): nodes not computed by the enclosing
+    // blocks go to the capture block, so box evaluation never runs them.
+    Slot emit_captured(NodeId id) {
+        if (auto it = capture_->memo.find(id); it != capture_->memo.end()) return it->second;
+        if (is_series(g_[id].op) || g_[id].op == Op::Index || g_[id].op == Op::State)
+            throw std::logic_error("tape: a point bound reads a value its series has not computed");
+        const Slot out = emit_op(id, *capture_);
+        capture_->memo[id] = out;
+        return out;
+    }
+
+    void emit_point_bounds(const Node& n, TapeSeries& s) {
+        bool needed = false;
+        for (std::size_t k = 0; k < 4; ++k) needed |= n.point_tail[k] != n.args[1 + k / 2];
+        if (!needed) {
+            for (std::size_t k = 0; k < 4; ++k) s.point_tail[k] = k < 2 ? s.tail_a : s.tail_b;
+            return;
+        }
+        s.point_block = static_cast<std::uint32_t>(t_.blocks.size());
+        t_.blocks.emplace_back();
+        Context capture{-1, s.point_block, {}};
+        capture_ = &capture;
+        for (std::size_t k = 0; k < 4; ++k)
+            if (n.point_tail[k] != no_node) s.point_tail[k] = emit(n.point_tail[k]);
+        capture_ = nullptr;
+        if (t_.blocks.back().empty()) { // bounds that are constants or already computed
+            t_.blocks.pop_back();
+            s.point_block = no_block;
+        }
     }
 
     NodeId find_leaf(Op op, std::int64_t imm) {
@@ -123,6 +156,7 @@ private:
     const Graph& g_;
     Tape& t_;
     std::vector<Context> contexts_;
+    Context* capture_ = nullptr;
     std::unordered_map<NodeId, Slot> const_slots_;
 };
 
@@ -168,8 +202,18 @@ void print_block(const Tape& t, std::uint32_t b, int indent, std::string& out) {
             if (s.data.end == infinite_end)
                 out += fmt::format(" tail ({} + {} i) * {}^i", slot_name(s.tail_a), slot_name(s.tail_b),
                                    interval_text(s.data.gamma));
+            for (std::size_t k = 0; k < 2; ++k) {
+                const Slot lo = s.point_tail[2 * k], hi = s.point_tail[2 * k + 1];
+                if (lo != (k ? s.tail_b : s.tail_a) || hi != lo)
+                    out += fmt::format(" point {} in [{}, {}]", k ? "B" : "A", slot_name(lo), slot_name(hi));
+            }
             if (s.data.escape.present) out += escape_text(s.data.escape);
             out += "\n";
+            if (s.point_block != no_block) {
+                out += fmt::format("{}point bounds {{\n", pad);
+                print_block(t, s.point_block, indent + 2, out);
+                out += fmt::format("{}}}\n", pad);
+            }
             continue;
         }
         out += fmt::format("{}{} = {}", pad, slot_name(ins.out), op_name(ins.op));
@@ -229,6 +273,14 @@ std::string verify_block(const Tape& t, std::uint32_t b, std::vector<bool>& writ
                 if (s.tail_a == no_slot || !written[s.tail_a])
                     return "infinite series without tail coefficient";
                 if (s.tail_b != no_slot && !written[s.tail_b]) return "series tail coefficient not written";
+                if (s.point_block != no_block) {
+                    if (s.point_block <= s.block || s.point_block >= t.blocks.size())
+                        return fmt::format("series point block {} out of order", s.point_block);
+                    if (auto e = verify_block(t, s.point_block, written); !e.empty()) return e;
+                }
+                for (const Slot p : s.point_tail)
+                    if (p != no_slot && (p >= t.num_slots || !written[p]))
+                        return "series point bound of the tail not written";
                 if (!(s.data.gamma.lo > 0 && s.data.gamma.hi < 1))
                     return "infinite series without decay in (0, 1)";
             }

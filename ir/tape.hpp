@@ -1,5 +1,6 @@
 // The flat tape: the graph of one root scheduled into straight-line blocks of SSA instructions over a
-// single slot file. Block 0 is the main code; each series has its own block, run once per term.
+// single slot file. Block 0 is the main code; each series has its own block, run once per term, and
+// may have a block of point-only code (TapeSeries::point_block).
 // Code that does not depend on a series index is hoisted out of that series' block.
 #pragma once
 
@@ -12,6 +13,7 @@ namespace frac::ir {
 
 using Slot = std::uint32_t;
 inline constexpr Slot no_slot = std::numeric_limits<Slot>::max();
+inline constexpr std::uint32_t no_block = std::numeric_limits<std::uint32_t>::max();
 
 struct Instr {
     Op op = Op::Add;
@@ -28,6 +30,13 @@ struct TapeSeries {
     Slot index_slot = no_slot;
     Slot body_slot = no_slot;
     Slot tail_a = no_slot, tail_b = no_slot; // infinite series: tail coefficients (tail_b optional)
+    // Infinite series: slots whose point values bound A and B (lo A, hi A, lo B, hi B), for point
+    // evaluation, which cannot read bounds off tail_a / tail_b (ir/point_bounds.hpp). The code that
+    // computes them and nothing else is `point_block`, which point evaluation runs before the series'
+    // first term (in the enclosing block's context) and box evaluation never runs. Without them
+    // (a specialised tape, made for boxes) point evaluation sums up to the term limit.
+    std::array<Slot, 4> point_tail{no_slot, no_slot, no_slot, no_slot};
+    std::uint32_t point_block = no_block;
     // Orbit series: the point's slots, read by the block; their initial values (computed before the
     // series) and the map's values (computed by the block), copied into state_slots after each term.
     std::vector<Slot> state_slots, init_slots, update_slots;

@@ -41,6 +41,13 @@ std::string verify_graph(const Graph& g) {
                     if (a != no_node && (g[a].index_mask >> s.level) & 1)
                         return fmt::format("%{}: tail coefficient depends on the series index", id);
                 }
+                for (int i = 0; i < 4; ++i) {
+                    const NodeId a = n.point_tail[static_cast<std::size_t>(i)];
+                    if ((a == no_node) != (n.args[1 + i / 2] == no_node))
+                        return fmt::format("%{}: point bounds of the tail do not match its coefficients", id);
+                    if (a != no_node && (a >= id || (g[a].index_mask >> s.level) & 1))
+                        return fmt::format("%{}: malformed point bound of the tail", id);
+                }
             }
         }
     }

@@ -228,12 +228,17 @@ private:
     double series_point(const TapeSeries& s) {
         const bool infinite = s.data.end == ir::infinite_end;
         const bool has_b = s.tail_b != ir::no_slot;
-        const double a = infinite ? std::fabs(points_[s.tail_a]) : 0.0;
-        const double b = has_b ? std::fabs(points_[s.tail_b]) : 0.0;
+        if (s.point_block != ir::no_block) run_points(s.point_block);
+        // Bounds of A and B at this point (not their point values: those are no bounds).
+        auto bound = [&](std::size_t k) {
+            return s.point_tail[k] == ir::no_slot ? std::nan("") : points_[s.point_tail[k]];
+        };
+        const double a = infinite ? ir::point_magnitude(bound(0), bound(1)) : 0.0;
+        const double b = has_b ? ir::point_magnitude(bound(2), bound(3)) : 0.0;
         const double gamma = s.data.gamma.hi;
         const std::int64_t last = last_index(s);
         double gamma_next = infinite ? std::pow(gamma, static_cast<double>(s.data.start + 1)) : 0.0;
-        double acc = 0.0;
+        double acc = 0.0, comp = 0.0;
         std::int64_t i = s.data.start;
         bool resolved = !infinite;
         for (std::size_t c = 0; c < s.state_slots.size(); ++c)
@@ -243,7 +248,12 @@ private:
             run_points(s.block);
             const double term = points_[s.body_slot];
             advance_orbit(points_, s);
-            acc = i == s.data.start ? term : ir::series_combine_point(s.kind, acc, term);
+            if (i == s.data.start)
+                acc = term;
+            else if (s.kind == Op::SeriesSum)
+                ir::compensated_add(acc, comp, term);
+            else
+                acc = ir::series_combine_point(s.kind, acc, term);
             ++stats.series_terms;
             if (i == last) break;
             if (infinite && s.data.escape.present) {
@@ -256,7 +266,7 @@ private:
                     break;
                 }
             } else if (infinite && !s.data.one_sided) {
-                // Estimate of the tail's size: stop once it is below half an ulp of the sum.
+                // A bound of the tail's size: stop once it is below half an ulp of the sum.
                 const double n1 = static_cast<double>(i + 1);
                 const double tail = (a + b * n1) * gamma_next * (n1 + 1.0) / ((1.0 - gamma) * (1.0 - gamma));
                 if (tail <= 0x1p-54 * std::fabs(acc) || tail == 0.0) {
@@ -266,19 +276,12 @@ private:
                 gamma_next *= gamma;
             }
         }
-        if (!infinite) return acc;
+        if (!infinite) return acc + comp;
         if (!resolved) ++stats.series_capped;
-        if (s.data.escape.present || s.data.one_sided) return acc; // no tail estimate from a one-sided bound
-        Interval tail;
-        {
-            num::UpwardRounding up;
-            tail =
-                ir::series_tail(s.kind, Interval(points_[s.tail_a]),
-                                has_b ? Interval(points_[s.tail_b]) : Interval(0.0), has_b, s.data.gamma, i);
-        }
-        // A tail unbounded on one side tells nothing about the value: keep the partial result.
-        if (!std::isfinite(tail.lo) || !std::isfinite(tail.hi)) return acc;
-        return ir::series_combine_point(s.kind, acc, num::midpoint(tail));
+        // No tail estimate from a one-sided bound (min and max series: comp is 0).
+        if (s.data.escape.present || s.data.one_sided) return acc + comp;
+        return ir::series_point_end(s.kind, acc, comp, bound(0), bound(1), bound(2), bound(3), has_b,
+                                    s.data.gamma, i);
     }
 
     Tape tape_;

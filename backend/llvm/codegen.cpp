@@ -13,6 +13,8 @@
 #include <llvm/IR/Intrinsics.h>
 #include <llvm/IR/Module.h>
 
+#include <cmath>
+#include <limits>
 #include <map>
 #include <stdexcept>
 
@@ -173,6 +175,11 @@ private:
         return c;
     }
     Value* half_true(Value* x) { return b_.CreateFCmpOGT(x, cst(0.5)); }
+    // ir::point_magnitude: max(|lo|, |hi|), +inf when either is NaN.
+    Value* magnitude(Value* lo, Value* hi) {
+        Value* m = c_fmax(intrinsic(llvm::Intrinsic::fabs, lo), intrinsic(llvm::Intrinsic::fabs, hi));
+        return sel(b_.CreateFCmpUNO(lo, hi), cst(std::numeric_limits<double>::infinity()), m);
+    }
 
     Value* emit_op(const Instr& ins) {
         auto in = [&](int k) { return vals_[ins.in[static_cast<std::size_t>(k)]]; };
@@ -241,8 +248,13 @@ private:
         const bool has_b = s.tail_b != ir::no_slot;
         const std::int64_t start = s.data.start;
         const std::int64_t last = last_index(s);
-        Value* a = infinite ? intrinsic(llvm::Intrinsic::fabs, vals_[s.tail_a]) : cst(0.0);
-        Value* bc = has_b ? intrinsic(llvm::Intrinsic::fabs, vals_[s.tail_b]) : cst(0.0);
+        if (s.point_block != ir::no_block) emit_block(s.point_block);
+        // Bounds of A and B at this point (not their point values: those are no bounds).
+        auto bound = [&](std::size_t k) {
+            return s.point_tail[k] == ir::no_slot ? cst(std::nan("")) : vals_[s.point_tail[k]];
+        };
+        Value* a = infinite ? magnitude(bound(0), bound(1)) : cst(0.0);
+        Value* bc = has_b ? magnitude(bound(2), bound(3)) : cst(0.0);
         const double gamma = s.data.gamma.hi;
 
         BasicBlock* pre = b_.GetInsertBlock();
@@ -253,9 +265,11 @@ private:
         b_.SetInsertPoint(header);
         llvm::PHINode* i = b_.CreatePHI(i64_, 2, "i");
         llvm::PHINode* acc = b_.CreatePHI(dbl_, 2, "acc");
+        llvm::PHINode* comp = b_.CreatePHI(dbl_, 2, "comp"); // sums: ir::compensated_add's error term
         llvm::PHINode* gnext = b_.CreatePHI(dbl_, 2, "gamma.next");
         i->addIncoming(b_.getInt64(static_cast<std::uint64_t>(start)), pre);
         acc->addIncoming(cst(0.0), pre);
+        comp->addIncoming(cst(0.0), pre);
         gnext->addIncoming(cst(infinite ? st.point_gamma_next : 0.0), pre);
         std::vector<llvm::PHINode*> state_phis;
         for (std::size_t c = 0; c < s.state_slots.size(); ++c) {
@@ -274,6 +288,17 @@ private:
         Value* term = vals_[s.body_slot];
         Value* first = b_.CreateICmpEQ(i, b_.getInt64(static_cast<std::uint64_t>(start)));
         Value* nacc = sel(first, term, combine(s.kind, acc, term));
+        Value* ncomp = cst(0.0);
+        if (s.kind == Op::SeriesSum) {
+            // ir::compensated_add, operation for operation.
+            Value* err = sel(b_.CreateFCmpOGE(intrinsic(llvm::Intrinsic::fabs, acc),
+                                              intrinsic(llvm::Intrinsic::fabs, term)),
+                             b_.CreateFAdd(b_.CreateFSub(acc, nacc), term),
+                             b_.CreateFAdd(b_.CreateFSub(term, nacc), acc));
+            Value* finite = b_.CreateFCmpOLT(intrinsic(llvm::Intrinsic::fabs, nacc),
+                                             cst(std::numeric_limits<double>::infinity()));
+            ncomp = sel(first, cst(0.0), sel(finite, b_.CreateFAdd(comp, err), comp));
+        }
         bump(terms_, b_.getInt64(1));
         Value* is_last = b_.CreateICmpEQ(i, b_.getInt64(static_cast<std::uint64_t>(last)));
         Value* gnext2 = gnext;
@@ -315,20 +340,24 @@ private:
         b_.SetInsertPoint(latch);
         i->addIncoming(b_.CreateAdd(i, b_.getInt64(1)), latch);
         acc->addIncoming(nacc, latch);
+        comp->addIncoming(ncomp, latch);
         gnext->addIncoming(gnext2, latch);
         for (std::size_t c = 0; c < state_phis.size(); ++c) state_phis[c]->addIncoming(next_state[c], latch);
         b_.CreateBr(header);
 
         b_.SetInsertPoint(exit);
-        if (!infinite) return nacc;
+        Value* total = b_.CreateFAdd(nacc, ncomp);
+        if (!infinite) return total;
         bump(capped_, b_.CreateZExt(is_last, i64_));
-        if (s.data.escape.present || s.data.one_sided) return nacc; // no tail estimate from a one-sided bound
-        // The tail's midpoint, from ir::series_tail under upward rounding (as the interpreter does).
-        Function* end_fn =
-            declare("frac_jit_point_series_end", dbl_, {i32_, dbl_, dbl_, dbl_, i32_, dbl_, dbl_, i64_});
-        return b_.CreateCall(end_fn, {b_.getInt32(static_cast<std::uint32_t>(s.kind)), nacc, vals_[s.tail_a],
-                                      has_b ? vals_[s.tail_b] : cst(0.0), b_.getInt32(has_b ? 1 : 0),
-                                      cst(s.data.gamma.lo), cst(s.data.gamma.hi), i});
+        // No tail estimate from a one-sided bound (min and max series: comp is 0).
+        if (s.data.escape.present || s.data.one_sided) return total;
+        // The tail's midpoint (ir::series_point_end, as the interpreter).
+        Function* end_fn = declare("frac_jit_point_series_end", dbl_,
+                                   {i32_, dbl_, dbl_, dbl_, dbl_, dbl_, dbl_, i32_, dbl_, dbl_, i64_});
+        return b_.CreateCall(end_fn,
+                             {b_.getInt32(static_cast<std::uint32_t>(s.kind)), nacc, ncomp, bound(0),
+                              bound(1), has_b ? bound(2) : cst(0.0), has_b ? bound(3) : cst(0.0),
+                              b_.getInt32(has_b ? 1 : 0), cst(s.data.gamma.lo), cst(s.data.gamma.hi), i});
     }
 
     void emit_block(std::uint32_t block) {

@@ -179,17 +179,11 @@ CInterval frac_jit_series_tail(int kind, double alo, double ahi, double blo, dou
                                      {gamma_lo, gamma_hi}, n));
 }
 
-double frac_jit_point_series_end(int kind, double acc, double a, double b, int has_b, double gamma_lo,
-                                 double gamma_hi, std::int64_t n) noexcept {
-    const auto op = static_cast<frac::ir::Op>(kind);
-    num::Interval tail;
-    {
-        num::UpwardRounding up;
-        tail = frac::ir::series_tail(op, num::Interval(a), has_b ? num::Interval(b) : num::Interval(0.0),
-                                     has_b != 0, {gamma_lo, gamma_hi}, n);
-    }
-    if (!std::isfinite(tail.lo) || !std::isfinite(tail.hi)) return acc;
-    return frac::ir::series_combine_point(op, acc, num::midpoint(tail));
+double frac_jit_point_series_end(int kind, double acc, double comp, double a_lo, double a_hi, double b_lo,
+                                 double b_hi, int has_b, double gamma_lo, double gamma_hi,
+                                 std::int64_t n) noexcept {
+    return frac::ir::series_point_end(static_cast<frac::ir::Op>(kind), acc, comp, a_lo, a_hi, b_lo, b_hi,
+                                      has_b != 0, {gamma_lo, gamma_hi}, n);
 }
 
 } // extern "C"

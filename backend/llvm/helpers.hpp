@@ -74,9 +74,9 @@ double frac_jit_atan2_point(double y, double x) noexcept;
 // ir::series_tail(kind, A, B, has_b, gamma, n) (upward rounding active).
 frac::jit::CInterval frac_jit_series_tail(int kind, double alo, double ahi, double blo, double bhi, int has_b,
                                           double gamma_lo, double gamma_hi, std::int64_t n) noexcept;
-// The end of a series in point evaluation after index n: the partial result `acc` combined with the
-// midpoint of ir::series_tail's enclosure for A = [a, a], B = [b, b] (computed under upward rounding,
-// which it sets and restores itself), or `acc` alone when that tail is unbounded.
-double frac_jit_point_series_end(int kind, double acc, double a, double b, int has_b, double gamma_lo,
-                                 double gamma_hi, std::int64_t n) noexcept;
+// The end of a series in point evaluation after index n: ir::series_point_end, from the bounds of A
+// and B at the point (it sets and restores upward rounding itself).
+double frac_jit_point_series_end(int kind, double acc, double comp, double a_lo, double a_hi, double b_lo,
+                                 double b_hi, int has_b, double gamma_lo, double gamma_hi,
+                                 std::int64_t n) noexcept;
 }

@@ -236,9 +236,22 @@ std::size_t compare_library(const fs::path& dir, const std::string& model, const
             if (!same(c_boxes[i], is_empty_box ? Interval::empty() : jit_boxes[i])) ++box_mismatches;
             if (!same(c_points[i], jit_points[i])) ++point_mismatches;
         }
+        // A compiled point value lies in the compiled enclosure of its point (NaN where it is empty).
+        std::size_t outside = 0;
+        for (std::size_t i = 0; i < count; ++i) {
+            std::vector<Interval> thin;
+            for (int k = 0; k < d; ++k) thin.push_back(Interval(points[i * static_cast<std::size_t>(d) + k]));
+            const Interval r = f.box(thin.data());
+            const bool in =
+                r.is_empty() ? std::isnan(c_points[i]) : r.lo <= c_points[i] && c_points[i] <= r.hi;
+            if (!in && ++outside == 1 && first.empty())
+                first =
+                    "point " + std::to_string(i) + ": compiled " + hex(c_points[i]) + " outside " + hex(r);
+        }
         INFO(first);
         CHECK(box_mismatches == 0);
         CHECK(point_mismatches == 0);
+        CHECK(outside == 0);
     }
     return jit.eval.size();
 }

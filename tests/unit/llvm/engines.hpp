@@ -5,6 +5,7 @@
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/jit.hpp"
 #include "frontend/driver.hpp"
+#include "ir/graph.hpp"
 #include "ir/tape.hpp"
 
 #include <bit>
@@ -127,5 +128,49 @@ public:
 private:
     std::mt19937_64 rng_;
 };
+
+// Random expression graphs over x, y with every non-series opcode and constants of every kind.
+// `typed`: graphs the language can write (finite constants; logic operations on truth values only,
+// as conditions of selects), where point and interval semantics agree.
+inline ir::NodeId random_node(ir::Graph& g, BoxMaker& mk, int depth, bool typed = false) {
+    using ir::Op;
+    if (depth == 0 || mk.pick(6) == 0) {
+        switch (mk.pick(6)) {
+        case 0: return g.var(0);
+        case 1: return g.var(1);
+        case 2: {
+            const double vals[] = {0.0, -0.0, 1.0,    -1.0,  0.5,      3.0,
+                                   0.1, 2.75, 1e-310, 1e300, num::inf, -num::inf};
+            return g.constant(vals[mk.pick(typed ? 8 : 12)]);
+        }
+        case 3: return g.constant(Interval{-mk.uniform(0, 2), mk.uniform(0, 2)}, 0.0);
+        case 4: return g.constant(Interval{0.0, 1.0}, 0.5);
+        default: return g.var(mk.pick(2));
+        }
+    }
+    static const Op ops[] = {Op::Add,  Op::Sub, Op::Mul, Op::Div, Op::Neg,   Op::Sqr,   Op::PowI, Op::Pow,
+                             Op::Sqrt, Op::Abs, Op::Min, Op::Max, Op::Floor, Op::Ceil,  Op::Mod1, Op::Dz,
+                             Op::Sin,  Op::Cos, Op::Tan, Op::Exp, Op::Log,   Op::Atan2, Op::Lt,   Op::Le,
+                             Op::Gt,   Op::Ge,  Op::Eq,  Op::Ne,  Op::And,   Op::Or,    Op::Not,  Op::Select};
+    const Op op = ops[mk.pick(static_cast<int>(std::size(ops)))];
+    const int n = ir::arity(op);
+    ir::NodeId a[3] = {ir::no_node, ir::no_node, ir::no_node};
+    for (int k = 0; k < n; ++k) a[k] = random_node(g, mk, depth - 1, typed);
+    const std::int64_t imm = op == Op::PowI ? mk.pick(9) - 4 : 0;
+    if (typed && ir::op_class(op) == ir::OpClass::logic) {
+        // A condition: a comparison, a truth value of unknown sign, or a combination of comparisons.
+        static const Op tests[] = {Op::Lt, Op::Le, Op::Gt, Op::Ge};
+        auto condition = [&] {
+            if (mk.pick(4) == 0) return g.constant(Interval{0.0, 1.0}, 0.5);
+            return g.op(tests[mk.pick(4)], random_node(g, mk, depth - 1, true),
+                        random_node(g, mk, depth - 1, true));
+        };
+        ir::NodeId cond = condition();
+        if (mk.pick(3) == 0) cond = g.op(mk.pick(2) ? Op::And : Op::Or, cond, condition());
+        if (mk.pick(4) == 0) cond = g.op(Op::Not, cond);
+        return g.op(Op::Select, cond, a[0], op == Op::Select ? a[1] : random_node(g, mk, depth - 1, true));
+    }
+    return g.op(op, a[0], a[1], a[2], imm);
+}
 
 } // namespace frac::test

@@ -160,39 +160,6 @@ TEST_CASE("series of every kind agree: finite, infinite, with B, nested, orbits"
     }
 }
 
-namespace {
-
-// Random expression graphs over x, y with every non-series opcode and constants of every kind.
-ir::NodeId random_node(ir::Graph& g, BoxMaker& mk, int depth) {
-    using ir::Op;
-    if (depth == 0 || mk.pick(6) == 0) {
-        switch (mk.pick(6)) {
-        case 0: return g.var(0);
-        case 1: return g.var(1);
-        case 2: {
-            const double vals[] = {0.0,    -0.0,  1.0,      -1.0,      0.5, 3.0,
-                                   1e-310, 1e300, num::inf, -num::inf, 0.1, 2.75};
-            return g.constant(vals[mk.pick(12)]);
-        }
-        case 3: return g.constant(Interval{-mk.uniform(0, 2), mk.uniform(0, 2)}, 0.0);
-        case 4: return g.constant(Interval{0.0, 1.0}, 0.5);
-        default: return g.var(mk.pick(2));
-        }
-    }
-    static const Op ops[] = {Op::Add,  Op::Sub, Op::Mul, Op::Div, Op::Neg,   Op::Sqr,   Op::PowI, Op::Pow,
-                             Op::Sqrt, Op::Abs, Op::Min, Op::Max, Op::Floor, Op::Ceil,  Op::Mod1, Op::Dz,
-                             Op::Sin,  Op::Cos, Op::Tan, Op::Exp, Op::Log,   Op::Atan2, Op::Lt,   Op::Le,
-                             Op::Gt,   Op::Ge,  Op::Eq,  Op::Ne,  Op::And,   Op::Or,    Op::Not,  Op::Select};
-    const Op op = ops[mk.pick(static_cast<int>(std::size(ops)))];
-    const int n = ir::arity(op);
-    ir::NodeId a[3] = {ir::no_node, ir::no_node, ir::no_node};
-    for (int k = 0; k < n; ++k) a[k] = random_node(g, mk, depth - 1);
-    const std::int64_t imm = op == Op::PowI ? mk.pick(9) - 4 : 0;
-    return g.op(op, a[0], a[1], a[2], imm);
-}
-
-} // namespace
-
 TEST_CASE("random expression graphs agree", "[llvm][crosscheck]") {
     BoxMaker mk(4242);
     for (int n = 0; n < 300; ++n) {
