@@ -177,8 +177,10 @@ int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions&
     rt::MeshSelection selection = rt::MeshSelection::inside;
     if (o.select == "cover")
         selection = rt::MeshSelection::inside_and_boundary;
+    else if (o.select == "boundary")
+        selection = rt::MeshSelection::boundary;
     else if (o.select != "inside")
-        throw RunError(fmt::format("unknown selection '{}' (inside, cover)", o.select));
+        throw RunError(fmt::format("unknown selection '{}': use inside, cover or boundary", o.select));
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
     const front::ShapeInfo& s = pick_shape(*c, o.shape);
@@ -189,6 +191,21 @@ int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions&
     // A mesh is of the closed solid {f <= 0}: cells whose faces lie on its surface are inside.
     const rt::RssResult r = cover(box, o.depth, o.split, true, engine.threads, *eval, true);
     const rt::Mesh mesh = rt::mesh_cover(r, selection);
+    if (mesh.stats.cells == 0) {
+        // Nothing to print: say why rather than write an empty file.
+        std::string hint;
+        if (selection == rt::MeshSelection::inside && r.boundary > 0)
+            hint = fmt::format(
+                "no cell is proven inside, {} are on the boundary. A shape without interior (a limit set, "
+                "a surface) has none: mesh its boundary cover as a thin solid with --select boundary. A "
+                "solid whose faces fall between doubles (j/27 is not a double) is never proven inside: "
+                "write it in lattice units, as the stdlib's menger3 on [0, 9]^3",
+                r.boundary);
+        else
+            hint = "the shape does not meet the box (every cell is outside): check its sign and --box";
+        throw RunError(
+            fmt::format("{}: depth {} split {}: nothing to mesh; {}", s.name, o.depth, o.split, hint));
+    }
     const rt::MeshCheck check = rt::check_mesh(mesh);
     std::cerr << fmt::format("{}: depth {} split {}: {} cells ({} inside, {} boundary), {} triangles; {}, "
                              "Euler characteristic {}, {} components\n",

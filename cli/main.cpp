@@ -60,7 +60,8 @@ int main(int argc, char** argv) {
     mesh->add_option("--split", mesh_options.split, "parts per axis and level")->check(CLI::Range(2, 4));
     mesh->add_option("--box", mesh_options.box, "box x0:x1,y0:y1,z0:z1 (default: the shape's)");
     mesh->add_option("--select", mesh_options.select,
-                     "inside: the proven-inside cells; cover: inside and boundary cells");
+                     "inside: the proven-inside cells; cover: inside and boundary cells; boundary: the "
+                     "boundary cells (a thin solid around the surface)");
     mesh->add_option("-o,--output", mesh_options.output, "mesh file: .stl (binary), .obj or .ply");
     add_engine(mesh);
 

@@ -365,7 +365,12 @@ struct Lattice {
 };
 
 bool is_selected(CellClass c, MeshSelection s) {
-    return c == CellClass::inside || (s == MeshSelection::inside_and_boundary && c == CellClass::boundary);
+    switch (s) {
+    case MeshSelection::inside: return c == CellClass::inside;
+    case MeshSelection::inside_and_boundary: return c == CellClass::inside || c == CellClass::boundary;
+    case MeshSelection::boundary: return c == CellClass::boundary;
+    }
+    return false;
 }
 
 void require_3d_cells(const RssResult& r, const char* what) {

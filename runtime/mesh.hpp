@@ -29,9 +29,11 @@
 
 namespace frac::rt {
 
-// Which leaves form the solid: the cells proven inside, or the whole cover (inside and boundary
-// cells; the boundary cells at the depth limit may hold points of the shape).
-enum class MeshSelection { inside, inside_and_boundary };
+// Which leaves form the solid: the cells proven inside, the whole cover (inside and boundary cells;
+// the boundary cells at the depth limit may hold points of the shape), or the boundary cells alone
+// (a thin solid around the surface: the printable form of a shape without interior, such as a
+// sponge's limit set or a surface given by its distance).
+enum class MeshSelection { inside, inside_and_boundary, boundary };
 
 struct MeshStats {
     std::uint64_t cells = 0;             // selected leaf cells
