@@ -19,6 +19,7 @@ std::unique_ptr<front::Compilation> compile_or_report(const std::string& path, f
         std::cerr << fmt::format("{} error{} in {}\n", n, n == 1 ? "" : "s", path);
         return nullptr;
     }
+    if (!c->diags.all().empty()) std::cerr << c->diags.render(c->sources); // warnings
     return c;
 }
 

@@ -32,6 +32,10 @@ void Diagnostics::error(Location loc, std::string message) {
     if (errors_ <= max_errors) list_.push_back({Severity::error, loc, std::move(message)});
 }
 
+void Diagnostics::warning(Location loc, std::string message) {
+    list_.push_back({Severity::warning, loc, std::move(message)});
+}
+
 void Diagnostics::note(Location loc, std::string message) {
     list_.push_back({Severity::note, loc, std::move(message)});
 }

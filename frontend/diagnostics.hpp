@@ -48,6 +48,7 @@ public:
 
     void error(Location loc, std::string message);
     void note(Location loc, std::string message);
+    void warning(Location loc, std::string message);
     bool has_errors() const { return errors_ > 0; }
     std::size_t error_count() const { return errors_; }
     const std::vector<Diagnostic>& all() const { return list_; }

@@ -666,6 +666,16 @@ private:
             escape = prove_orbit_escape(g_, body, map, data.level, kind, g_[radius].value, why);
         }
         if (!escape) fail(e.escape_loc, "cannot prove this escape certificate: " + why);
+        if (!(escape->slope > 0))
+            // The bound (s (|q| - r) + d) * scale is then never positive (negative for a max): it proves
+            // no cell outside the shape, and covers run every term of the orbit in vain.
+            d_.warning(
+                e.escape_loc,
+                fmt::format("this escape certificate cannot make a term {}: the term is bounded {} on "
+                            "the orbit point only by s |q| + d with s = 0; write it so that it grows "
+                            "with the norm of the orbit point (for example through sqrt(p.x^2 + p.y^2))",
+                            kind == Op::SeriesMin ? "positive" : "negative",
+                            kind == Op::SeriesMin ? "below" : "above"));
         return *escape;
     }
 

@@ -515,6 +515,15 @@ std::string num_text(double v) {
     return fmt::format("{:.6g}", v);
 }
 
+// Two numbers with as many digits as it takes to tell them apart (a radius that fails by rounding).
+std::pair<std::string, std::string> distinct_texts(double x, double y) {
+    for (int digits = 6; digits < 17; ++digits) {
+        std::string a = fmt::format("{:.{}g}", x, digits), b = fmt::format("{:.{}g}", y, digits);
+        if (a != b) return {a, b};
+    }
+    return {fmt::format("{:.17g}", x), fmt::format("{:.17g}", y)};
+}
+
 } // namespace
 
 std::optional<ir::OrbitEscape> prove_orbit_escape(Graph& g, NodeId term, const std::vector<NodeId>& map,
@@ -543,12 +552,13 @@ std::optional<ir::OrbitEscape> prove_orbit_escape(Graph& g, NodeId term, const s
                             "(by {} per step)",
                             num_text(a), num_text(b), num_text(split.growth.hi))};
         const double reach = num::mul(num::sub(Interval(a), Interval(1.0)), Interval(r)).lo;
+        const double escape_radius = num::div(Interval(b), num::sub(Interval(a), Interval(1.0))).hi;
         if (!(reach >= b))
-            throw Unproven{fmt::format(
-                "the map gives |M(q)| >= {} |q| - {}: orbits provably escape only outside "
-                "radius {} / ({} - 1) = {}, above the claimed {}",
-                num_text(a), num_text(b), num_text(b), num_text(a),
-                num_text(num::div(Interval(b), num::sub(Interval(a), Interval(1.0))).hi), num_text(r))};
+            throw Unproven{
+                fmt::format("the map gives |M(q)| >= {} |q| - {}: orbits provably escape only outside "
+                            "radius {} / ({} - 1) = {}, above the claimed {}",
+                            num_text(a), num_text(b), num_text(b), num_text(a),
+                            distinct_texts(escape_radius, r).first, distinct_texts(escape_radius, r).second)};
         ir::OrbitEscape e;
         e.present = true;
         e.radius = r;
