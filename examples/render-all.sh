@@ -5,24 +5,31 @@ frac=${1:?usage: render-all.sh FRAC OUTDIR}
 out=${2:?usage: render-all.sh FRAC OUTDIR}
 here=$(cd "$(dirname "$0")" && pwd)
 mkdir -p "$out"
+render_as() { # file shape depth name
+    "$frac" render "$here/$1" "$2" --depth "$3" --size 512 -o "$out/$4.png"
+}
 render() { # file shape depth
     "$frac" render "$here/$1" "$2" --depth "$3" --size 512 -o "$out/${1%.frac}.png"
     "$frac" render "$here/$1" "$2" --depth "$(( $3 < 8 ? $3 : 8 ))" -o "$out/${1%.frac}.svg"
 }
 render fig2_takagi.frac takagi_curve 12
 render fig3_staircase.frac staircase_graph 10
+for k in 0 1 2 3 4 5; do render_as fig4_cantor_levels.frac "cantor$k" 9 "fig4_cantor_C$k"; done
 render fig5_cantor.frac cantor_graph 10
 render fig6_carpet.frac sierpinski_carpet 9
 render fig7_triangle.frac sierpinski_triangle 9
-render_as() { # file shape depth name
-    "$frac" render "$here/$1" "$2" --depth "$3" --size 512 -o "$out/$4.png"
-}
 render_as fig9_koch_tiling.frac triangle_tiling 8 fig9_tiling
 render_as fig9_koch_tiling.frac lattice_disks 8 fig9_disks
+render_as fig8_stripes.frac stripe_triangles 8 fig8_stripes
+render_as fig10_double_koch.frac single_flake 8 fig10_single_flake
 render fig10_double_koch.frac double_flake 8
 render_as fig11_koch_levels.frac flake0 8 fig11_flake0
 render_as fig11_koch_levels.frac flake1 8 fig11_flake1
 render_as fig11_koch_levels.frac flake2 8 fig11_flake2
+render_as fig11_koch_levels.frac double0 8 fig11_double0
+render_as fig11_koch_levels.frac double1 8 fig11_double1
+render_as fig11_koch_levels.frac double2 8 fig11_double2
+render_as fig12_lattice_plane.frac plane_lattice 8 fig12_lattice_plane
 render fig13_koch_polar.frac koch_flake 9
 render similitude_disks.frac turned_disks_direct 8
 render_as rough_terrain.frac terrain_profile 9 rough_terrain_profile
