@@ -5,7 +5,11 @@
 #include "runtime/dimension.hpp"
 #include "runtime/mesh.hpp"
 #include "runtime/picture.hpp"
+#include "runtime/relief.hpp"
 #include "runtime/rss.hpp"
+#include "runtime/slice.hpp"
+#include <cmath>
+#include <cstdlib>
 
 #include <fmt/format.h>
 #include <iostream>
@@ -120,14 +124,49 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
     const front::ShapeInfo& s = pick_shape(*c, o.shape);
-    if (s.dimension != 2)
-        throw RunError(fmt::format("shape '{}' is {}D; pictures are of 2D shapes", s.name, s.dimension));
+    // A 3D shape is drawn as a plane section (--slice) or as a shaded relief of its cover from above.
+    int slice_axis = -1;
+    double slice_value = 0;
+    if (!o.slice.empty()) {
+        const auto eq = o.slice.find('=');
+        const std::string axis = o.slice.substr(0, eq);
+        slice_axis = axis == "x" ? 0 : axis == "y" ? 1 : axis == "z" ? 2 : -1;
+        const std::string value = eq == std::string::npos ? "" : o.slice.substr(eq + 1);
+        char* end = nullptr;
+        slice_value = std::strtod(value.c_str(), &end);
+        if (eq == std::string::npos || slice_axis < 0 || value.empty() || *end != '\0' ||
+            !std::isfinite(slice_value))
+            throw RunError(fmt::format("--slice needs AXIS=VALUE such as z=0.5, not '{}'", o.slice));
+        if (s.dimension != 3) throw RunError(fmt::format("--slice is for 3D shapes; '{}' is 2D", s.name));
+    }
+    if (s.dimension == 3 && slice_axis < 0 && (!o.ascii.empty() || ends_with(o.output, ".svg")))
+        throw RunError(fmt::format("shape '{}' is 3D: draw a section with --slice z=VALUE, or a relief "
+                                   "(shaded depth image) as .png",
+                                   s.name));
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
-    const rt::RssResult r = cover(box, o.depth, o.split, true, engine.threads, *eval);
+    const rt::RssResult full = cover(box, o.depth, o.split, true, engine.threads, *eval);
     std::cerr << fmt::format(
         "{}: depth {}, {} boxes evaluated: {} inside, {} outside, {} boundary; {:.3f} s\n", s.name, o.depth,
-        r.evaluated, r.inside, r.outside, r.boundary, r.seconds);
+        full.evaluated, full.inside, full.outside, full.boundary, full.seconds);
+    if (s.dimension == 3 && slice_axis < 0) {
+        if (o.size < 16 || o.size > 8192) throw RunError("--size must be between 16 and 8192 pixels");
+        try {
+            rt::write_png(rt::relief_image(full, o.size), o.output);
+        } catch (const std::runtime_error& e) {
+            throw RunError(e.what());
+        }
+        std::cerr << fmt::format("wrote {} (relief seen from +z)\n", o.output);
+        return 0;
+    }
+    rt::RssResult section;
+    if (slice_axis >= 0) {
+        if (!(slice_value >= box[static_cast<std::size_t>(slice_axis)].lo &&
+              slice_value <= box[static_cast<std::size_t>(slice_axis)].hi))
+            throw RunError(fmt::format("--slice {}: the value lies outside the box", o.slice));
+        section = rt::slice(full, slice_value, slice_axis);
+    }
+    const rt::RssResult& r = slice_axis >= 0 ? section : full;
     if (!o.ascii.empty()) {
         int cols = 0, rows = 0;
         if (std::sscanf(o.ascii.c_str(), "%dx%d", &cols, &rows) != 2 || cols < 1 || rows < 1 || cols > 1000 ||

@@ -9,7 +9,7 @@
 namespace frac::cli {
 
 struct RenderOptions {
-    std::string shape, box, output, kind = "both", ascii;
+    std::string shape, box, output, kind = "both", ascii, slice;
     int depth = 8, split = 2, size = 512;
 };
 

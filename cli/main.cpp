@@ -39,7 +39,8 @@ int main(int argc, char** argv) {
     add_engine(eval);
 
     cli::RenderOptions render_options;
-    auto* render = app.add_subcommand("render", "cover a 2D shape by recursive subdivision and draw it");
+    auto* render = app.add_subcommand(
+        "render", "cover a shape by recursive subdivision and draw it (3D: a section or a shaded relief)");
     render->add_option("file", file, "model file")->required();
     render->add_option("shape", render_options.shape, "shape name (default: the last shape of the file)");
     render->add_option("--depth", render_options.depth, "subdivision depth")->check(CLI::Range(0, 64));
@@ -49,6 +50,10 @@ int main(int argc, char** argv) {
     render->add_option("--kind", render_options.kind, "process, cover or both (side by side)");
     render->add_option("--size", render_options.size, "pixels per panel (PNG)");
     render->add_option("--ascii", render_options.ascii, "also print a COLSxROWS character picture");
+    render->add_option(
+        "--slice", render_options.slice,
+        "3D shapes: draw the section by the plane AXIS=VALUE (x, y or z), e.g. z=0.5; without it "
+        "a 3D shape is drawn as a shaded relief seen from +z (.png)");
     add_engine(render);
 
     cli::MeshOptions mesh_options;
