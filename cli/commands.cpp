@@ -110,6 +110,18 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 
 } // namespace
 
+namespace {
+
+// Refuses an output whose estimated size exceeds the limit unless forced.
+void check_output_size(const std::string& path, double bytes, bool force) {
+    if (bytes <= output_size_limit || force) return;
+    throw RunError(fmt::format("'{}' would be about {:.0f} MB (the limit is {:.0f} MB): lower --depth, or "
+                               "pass --force to write it anyway",
+                               path, bytes / 1e6, output_size_limit / 1e6));
+}
+
+} // namespace
+
 int run_render(const std::string& file, const RenderOptions& o, const EngineOptions& engine) {
     if (o.output.empty() && o.ascii.empty()) throw RunError("give -o out.png|out.svg or --ascii COLSxROWS");
     rt::PictureKind kind = rt::PictureKind::both;
@@ -177,10 +189,17 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
     if (!o.output.empty()) {
         if (o.size < 16 || o.size > 8192) throw RunError("--size must be between 16 and 8192 pixels");
         try {
-            if (ends_with(o.output, ".png"))
+            if (ends_with(o.output, ".png")) {
                 rt::write_png(r, o.output, kind, o.size);
-            else
+            } else {
+                // About 48 bytes a rectangle (measured): the cover's inside and boundary leaves, the
+                // process's cells.
+                const double cells =
+                    static_cast<double>(r.inside + r.boundary) +
+                    (kind == rt::PictureKind::cover ? 0.0 : static_cast<double>(r.evaluated));
+                check_output_size(o.output, 48 * cells, o.force);
                 rt::write_svg(r, o.output, kind);
+            }
         } catch (const std::runtime_error& e) {
             throw RunError(e.what());
         }
@@ -252,6 +271,11 @@ int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions&
                              mesh.triangles.size(),
                              check.ok() ? "watertight and manifold" : "NOT printable: " + check.problem,
                              check.euler, check.components);
+    // Binary STL takes 50 bytes a triangle; OBJ and PLY text about as much with the vertices.
+    check_output_size(o.output,
+                      50.0 * static_cast<double>(mesh.triangles.size()) +
+                          40.0 * static_cast<double>(mesh.vertices.size()),
+                      o.force);
     try {
         rt::write_mesh(mesh, o.output);
     } catch (const std::exception& e) {

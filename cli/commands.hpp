@@ -11,15 +11,20 @@ namespace frac::cli {
 struct RenderOptions {
     std::string shape, box, output, kind = "both", ascii, slice;
     int depth = 8, split = 2, size = 512;
+    bool force = false; // write an SVG over the size limit
 };
 
 int run_check(const std::string& file, const std::string& emit, const std::string& shape);
 int run_eval(const std::string& file, const std::string& shape, const std::string& at, const std::string& box,
              const EngineOptions& engine);
+// Largest file `render` and `mesh` write without --force (an estimate, checked before writing).
+inline constexpr double output_size_limit = 100e6;
+
 int run_render(const std::string& file, const RenderOptions& options, const EngineOptions& engine);
 struct MeshOptions {
     std::string shape, box, output, select = "inside";
     int depth = 4, split = 2;
+    bool force = false; // write a mesh over the size limit
 };
 int run_mesh(const std::string& file, const MeshOptions& options, const EngineOptions& engine);
 int run_dimension(const std::string& file, const std::string& shape, int from, int to, int split,

@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
     render->add_option("--kind", render_options.kind, "process, cover or both (side by side)");
     render->add_option("--size", render_options.size, "pixels per panel (PNG)");
     render->add_option("--ascii", render_options.ascii, "also print a COLSxROWS character picture");
+    render->add_flag("--force", render_options.force, "write an SVG estimated above 100 MB");
     render->add_option(
         "--slice", render_options.slice,
         "3D shapes: draw the section by the plane AXIS=VALUE (x, y or z), e.g. z=0.5; without it "
@@ -68,6 +69,7 @@ int main(int argc, char** argv) {
                      "inside: the proven-inside cells; cover: inside and boundary cells; boundary: the "
                      "boundary cells (a thin solid around the surface)");
     mesh->add_option("-o,--output", mesh_options.output, "mesh file: .stl (binary), .obj or .ply");
+    mesh->add_flag("--force", mesh_options.force, "write a mesh estimated above 100 MB");
     add_engine(mesh);
 
     int from = 4, to = 9, split = 2;
