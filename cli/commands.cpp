@@ -171,14 +171,14 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
         std::cerr << fmt::format("wrote {} (relief seen from +z)\n", o.output);
         return 0;
     }
-    rt::RssResult section;
+    rt::Cover section;
     if (slice_axis >= 0) {
         if (!(slice_value >= box[static_cast<std::size_t>(slice_axis)].lo &&
               slice_value <= box[static_cast<std::size_t>(slice_axis)].hi))
             throw RunError(fmt::format("--slice {}: the value lies outside the box", o.slice));
         section = rt::slice(full, slice_value, slice_axis);
     }
-    const rt::RssResult& r = slice_axis >= 0 ? section : full;
+    const rt::Cover& r = slice_axis >= 0 ? section : static_cast<const rt::Cover&>(full);
     if (!o.ascii.empty()) {
         int cols = 0, rows = 0;
         if (std::sscanf(o.ascii.c_str(), "%dx%d", &cols, &rows) != 2 || cols < 1 || rows < 1 || cols > 1000 ||

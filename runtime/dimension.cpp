@@ -11,7 +11,7 @@ namespace frac::rt {
 
 namespace {
 
-void check_range(const RssResult& r, int from_level, int to_level) {
+void check_range(const Cover& r, int from_level, int to_level) {
     const int depth = static_cast<int>(r.levels.size()) - 1;
     if (from_level < 0 || from_level >= to_level || to_level > depth)
         throw std::invalid_argument(
@@ -20,9 +20,9 @@ void check_range(const RssResult& r, int from_level, int to_level) {
 }
 
 // Least-squares slope of log N_k against k log(split) over the counts of levels from..to.
-DimensionEstimate fit(const RssResult& r, int from_level, const std::vector<std::uint64_t>& counts) {
+DimensionEstimate fit(const Cover& r, int from_level, const std::vector<std::uint64_t>& counts) {
     DimensionEstimate est;
-    const double log_split = std::log(static_cast<double>(r.options.split));
+    const double log_split = std::log(static_cast<double>(r.split));
     std::vector<double> xs, ys;
     bool constant = true;
     for (std::size_t i = 0; i < counts.size(); ++i) {
@@ -70,7 +70,7 @@ struct CellKeyHash {
 
 } // namespace
 
-DimensionEstimate box_counting(const RssResult& r, int from_level, int to_level) {
+DimensionEstimate box_counting(const Cover& r, int from_level, int to_level) {
     check_range(r, from_level, to_level);
     std::vector<std::uint64_t> counts;
     for (int k = from_level; k <= to_level; ++k)
@@ -78,13 +78,13 @@ DimensionEstimate box_counting(const RssResult& r, int from_level, int to_level)
     return fit(r, from_level, counts);
 }
 
-DimensionEstimate box_counting_proven(const RssResult& r, int from_level, int to_level) {
+DimensionEstimate box_counting_proven(const Cover& r, int from_level, int to_level) {
     check_range(r, from_level, to_level);
     if (r.cells.empty()) throw std::invalid_argument("box_counting_proven: the subdivision kept no cells");
     // For each level k, the cells with an inside (outside) cell strictly below them.
     const auto levels = static_cast<std::size_t>(to_level - from_level + 1);
     std::vector<std::unordered_set<CellKey, CellKeyHash>> with_in(levels), with_out(levels);
-    const auto split = static_cast<std::uint64_t>(r.options.split);
+    const auto split = static_cast<std::uint64_t>(r.split);
     for (const Cell& c : r.cells) {
         if (c.cls != CellClass::inside && c.cls != CellClass::outside) continue;
         std::uint64_t scale = 1; // split^(c.level - k)

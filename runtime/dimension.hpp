@@ -9,7 +9,7 @@
 // intercept, not the slope.
 #pragma once
 
-#include "runtime/rss.hpp"
+#include "runtime/cover.hpp"
 
 #include <cstdint>
 #include <utility>
@@ -31,10 +31,10 @@ struct DimensionEstimate {
 // through a rotation, for instance) thickens the undecided band and biases the first estimate up;
 // this one only loses cells that touch the boundary too little to hold a proven cell of each kind.
 // Needs a result with keep_cells. Same fit, same exceptions as box_counting.
-DimensionEstimate box_counting_proven(const RssResult& r, int from_level, int to_level);
+DimensionEstimate box_counting_proven(const Cover& r, int from_level, int to_level);
 
 // Fits the levels from_level..to_level (inclusive). Throws std::invalid_argument unless
 // 0 <= from_level < to_level <= depth, or when some N_k in the range is 0 (no boundary left).
-DimensionEstimate box_counting(const RssResult& r, int from_level, int to_level);
+DimensionEstimate box_counting(const Cover& r, int from_level, int to_level);
 
 } // namespace frac::rt

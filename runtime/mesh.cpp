@@ -36,6 +36,7 @@
 // Determinism: every step runs in a fixed order (planes, sweep, sorted indices), so the mesh, and
 // the file bytes, depend only on the cover.
 #include "runtime/mesh.hpp"
+#include "runtime/rss.hpp" // max_depth_3d
 
 #include <fmt/format.h>
 
@@ -373,18 +374,18 @@ bool is_selected(CellClass c, MeshSelection s) {
     return false;
 }
 
-void require_3d_cells(const RssResult& r, const char* what) {
+void require_3d_cells(const Cover& r, const char* what) {
     if (r.dimension() != 3) throw std::invalid_argument(fmt::format("{} needs a 3D cover", what));
     if (r.cells.empty())
         throw std::invalid_argument(
             fmt::format("{} needs the cells: run subdivide with keep_cells = true", what));
 }
 
-Lattice make_lattice(const RssResult& r, MeshSelection selection) {
+Lattice make_lattice(const Cover& r, MeshSelection selection) {
     require_3d_cells(r, "mesh_cover");
     Lattice L;
-    L.depth = r.options.depth;
-    L.split = r.options.split;
+    L.depth = r.depth;
+    L.split = r.split;
     if (L.depth < 0 || L.depth > max_depth_3d || L.split < 2 || L.split > 4)
         throw std::invalid_argument("mesh_cover: the cover's depth or split is out of range");
     L.n = r.cells_per_axis(L.depth);
@@ -421,7 +422,7 @@ struct LevelOrder {
     std::vector<Group> groups;
 };
 
-LevelOrder order_level(const RssResult& r, const u32* sel, std::size_t count, int axis, u64 per_axis) {
+LevelOrder order_level(const Cover& r, const u32* sel, std::size_t count, int axis, u64 per_axis) {
     LevelOrder lo;
     lo.cells.assign(sel, sel + count);
     const auto key = [&](u32 i) { return cell_coord(r.cells[i], axis); };
@@ -450,7 +451,7 @@ LevelOrder order_level(const RssResult& r, const u32* sel, std::size_t count, in
 }
 
 // Runs the sweeps of every plane normal to `axis`.
-void sweep_axis(const RssResult& r, const Lattice& L, int axis, PlaneSweep& sweep) {
+void sweep_axis(const Cover& r, const Lattice& L, int axis, PlaneSweep& sweep) {
     const int au = axis_u(axis), av = axis_v(axis);
     std::vector<LevelOrder> orders(static_cast<std::size_t>(L.depth) + 1);
     std::vector<u64> planes;
@@ -756,7 +757,7 @@ double lattice_coord(Interval axis, u64 i, u64 n) {
 
 } // namespace
 
-Mesh mesh_cover(const RssResult& r, MeshSelection selection) {
+Mesh mesh_cover(const Cover& r, MeshSelection selection) {
     const auto start = Clock::now();
     const Lattice L = make_lattice(r, selection);
     Mesh mesh;
@@ -816,16 +817,16 @@ Mesh mesh_cover(const RssResult& r, MeshSelection selection) {
     return mesh;
 }
 
-double selected_volume(const RssResult& r, MeshSelection selection) {
+double selected_volume(const Cover& r, MeshSelection selection) {
     require_3d_cells(r, "selected_volume");
     const long double w[3] = {static_cast<long double>(r.root[0].hi) - r.root[0].lo,
                               static_cast<long double>(r.root[1].hi) - r.root[1].lo,
                               static_cast<long double>(r.root[2].hi) - r.root[2].lo};
-    std::vector<u64> count(static_cast<std::size_t>(r.options.depth) + 1, 0);
+    std::vector<u64> count(static_cast<std::size_t>(r.depth) + 1, 0);
     for (const Cell& c : r.cells)
-        if (is_selected(c.cls, selection) && c.level <= r.options.depth) ++count[c.level];
+        if (is_selected(c.cls, selection) && c.level <= r.depth) ++count[c.level];
     long double v = 0;
-    for (int k = 0; k <= r.options.depth; ++k) {
+    for (int k = 0; k <= r.depth; ++k) {
         const auto n = static_cast<long double>(r.cells_per_axis(k));
         v += static_cast<long double>(count[static_cast<std::size_t>(k)]) / (n * n * n);
     }

@@ -20,7 +20,7 @@
 // root box, computed in double (the root's bounds exactly at i = 0 and i = 2n).
 #pragma once
 
-#include "runtime/rss.hpp"
+#include "runtime/cover.hpp"
 
 #include <array>
 #include <cstdint>
@@ -56,10 +56,10 @@ struct Mesh {
 
 // The mesh of the union of the selected leaves of a 3D cover computed with keep_cells. An empty
 // selection gives an empty mesh. Throws std::invalid_argument for a 2D cover or one without cells.
-Mesh mesh_cover(const RssResult& r, MeshSelection selection);
+Mesh mesh_cover(const Cover& r, MeshSelection selection);
 
 // Sum of the volumes of the selected leaves, from the exact grid geometry (long double sum).
-double selected_volume(const RssResult& r, MeshSelection selection);
+double selected_volume(const Cover& r, MeshSelection selection);
 
 // Signed volume enclosed by the mesh (divergence theorem; positive for outward orientation).
 double enclosed_volume(const Mesh& mesh);

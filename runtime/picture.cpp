@@ -50,7 +50,7 @@ bool is_leaf(CellClass c) {
     return c != CellClass::subdivided;
 }
 
-void require_2d_cells(const RssResult& r) {
+void require_2d_cells(const Cover& r) {
     if (r.dimension() != 2) throw std::invalid_argument("pictures need a 2D cover; use slices");
     if (r.cells.empty())
         throw std::invalid_argument("pictures need the cells: run subdivide with keep_cells = true");
@@ -61,7 +61,7 @@ struct PanelSize {
     int w, h;
 };
 
-PanelSize panel_size(const RssResult& r, int longer) {
+PanelSize panel_size(const Cover& r, int longer) {
     const double wx = r.root[0].hi - r.root[0].lo, wy = r.root[1].hi - r.root[1].lo;
     if (wx >= wy) return {longer, std::max(1, static_cast<int>(std::lround(longer * (wy / wx))))};
     return {std::max(1, static_cast<int>(std::lround(longer * (wx / wy)))), longer};
@@ -78,9 +78,9 @@ Span span(std::uint64_t i, std::uint64_t n, std::uint64_t units) {
 }
 
 // Per-level cache of split^level.
-std::vector<std::uint64_t> grid_sizes(const RssResult& r) {
+std::vector<std::uint64_t> grid_sizes(const Cover& r) {
     std::vector<std::uint64_t> n;
-    for (int k = 0; k <= r.options.depth; ++k) n.push_back(r.cells_per_axis(k));
+    for (int k = 0; k <= r.depth; ++k) n.push_back(r.cells_per_axis(k));
     return n;
 }
 
@@ -95,7 +95,7 @@ struct Raster {
     std::size_t at(std::uint64_t x, std::uint64_t y) const { return y * static_cast<std::uint64_t>(w) + x; }
 };
 
-Raster rasterize(const RssResult& r, PanelSize size, bool outlines) {
+Raster rasterize(const Cover& r, PanelSize size, bool outlines) {
     Raster ras(size.w, size.h);
     const auto n_of = grid_sizes(r);
     const auto W = static_cast<std::uint64_t>(size.w), H = static_cast<std::uint64_t>(size.h);
@@ -182,11 +182,10 @@ private:
 };
 
 // Index ranges of the levels in r.cells (cells are ordered by level).
-std::vector<std::pair<std::size_t, std::size_t>> level_ranges(const RssResult& r) {
-    std::vector<std::pair<std::size_t, std::size_t>> ranges(static_cast<std::size_t>(r.options.depth) + 1,
-                                                            {0, 0});
+std::vector<std::pair<std::size_t, std::size_t>> level_ranges(const Cover& r) {
+    std::vector<std::pair<std::size_t, std::size_t>> ranges(static_cast<std::size_t>(r.depth) + 1, {0, 0});
     std::size_t i = 0;
-    for (int k = 0; k <= r.options.depth; ++k) {
+    for (int k = 0; k <= r.depth; ++k) {
         const std::size_t begin = i;
         while (i < r.cells.size() && r.cells[i].level == k) ++i;
         ranges[static_cast<std::size_t>(k)] = {begin, i};
@@ -196,7 +195,7 @@ std::vector<std::pair<std::size_t, std::size_t>> level_ranges(const RssResult& r
 
 // Rects of the cells of [begin, end) whose class passes `keep`, in one <g fill=...> group.
 template <typename Keep>
-void svg_rects(SvgWriter& out, const RssResult& r, std::pair<std::size_t, std::size_t> range, Keep keep,
+void svg_rects(SvgWriter& out, const Cover& r, std::pair<std::size_t, std::size_t> range, Keep keep,
                const char* fill, PanelSize size, std::uint64_t n) {
     const double cw = static_cast<double>(size.w) / static_cast<double>(n);
     const double ch = static_cast<double>(size.h) / static_cast<double>(n);
@@ -221,11 +220,11 @@ void svg_rects(SvgWriter& out, const RssResult& r, std::pair<std::size_t, std::s
     if (open) fmt::format_to(std::back_inserter(out.buf()), "</g>\n");
 }
 
-void svg_process(SvgWriter& out, const RssResult& r, PanelSize size, int ox) {
+void svg_process(SvgWriter& out, const Cover& r, PanelSize size, int ox) {
     const auto ranges = level_ranges(r);
     fmt::format_to(std::back_inserter(out.buf()), "<g transform=\"translate({},0)\" stroke=\"#000000\">\n",
                    ox);
-    for (int k = 0; k <= r.options.depth; ++k) {
+    for (int k = 0; k <= r.depth; ++k) {
         const std::uint64_t n = r.cells_per_axis(k);
         const double cell = std::min(size.w, size.h) / static_cast<double>(n);
         if (cell < 0.3) break; // too small to see: the undecided parents show the region
@@ -244,14 +243,14 @@ void svg_process(SvgWriter& out, const RssResult& r, PanelSize size, int ox) {
     fmt::format_to(std::back_inserter(out.buf()), "</g>\n");
 }
 
-void svg_cover(SvgWriter& out, const RssResult& r, PanelSize size, int ox) {
+void svg_cover(SvgWriter& out, const Cover& r, PanelSize size, int ox) {
     const auto ranges = level_ranges(r);
     fmt::format_to(std::back_inserter(out.buf()), "<g transform=\"translate({},0)\">\n", ox);
-    for (int k = 0; k <= r.options.depth; ++k)
+    for (int k = 0; k <= r.depth; ++k)
         svg_rects(
             out, r, ranges[static_cast<std::size_t>(k)], [](CellClass c) { return c == CellClass::inside; },
             svg_cover_inside, size, r.cells_per_axis(k));
-    for (int k = 0; k <= r.options.depth; ++k)
+    for (int k = 0; k <= r.depth; ++k)
         svg_rects(
             out, r, ranges[static_cast<std::size_t>(k)], [](CellClass c) { return c == CellClass::boundary; },
             svg_cover_boundary, size, r.cells_per_axis(k));
@@ -260,7 +259,7 @@ void svg_cover(SvgWriter& out, const RssResult& r, PanelSize size, int ox) {
 
 } // namespace
 
-Image render(const RssResult& r, PictureKind kind, int pixels) {
+Image render(const Cover& r, PictureKind kind, int pixels) {
     require_2d_cells(r);
     if (pixels < 1 || pixels > 16384)
         throw std::invalid_argument(fmt::format("render: pixels {} is out of range [1, 16384]", pixels));
@@ -300,11 +299,11 @@ void write_png(const Image& image, const std::string& path) {
     }
 }
 
-void write_png(const RssResult& r, const std::string& path, PictureKind kind, int pixels) {
+void write_png(const Cover& r, const std::string& path, PictureKind kind, int pixels) {
     write_png(render(r, kind, pixels), path);
 }
 
-void write_svg(const RssResult& r, const std::string& path, PictureKind kind) {
+void write_svg(const Cover& r, const std::string& path, PictureKind kind) {
     require_2d_cells(r);
     const PanelSize size = panel_size(r, 1024);
     const int gap = kind == PictureKind::both ? 16 : 0;
@@ -322,7 +321,7 @@ void write_svg(const RssResult& r, const std::string& path, PictureKind kind) {
     out.close();
 }
 
-std::string ascii_picture(const RssResult& r, int columns, int rows) {
+std::string ascii_picture(const Cover& r, int columns, int rows) {
     require_2d_cells(r);
     if (columns < 1 || columns > 4096 || rows < 1 || rows > 4096)
         throw std::invalid_argument(

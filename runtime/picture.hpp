@@ -16,7 +16,7 @@
 // otherwise ("pictures need a 2D cover; use slices" for 3D).
 #pragma once
 
-#include "runtime/rss.hpp"
+#include "runtime/cover.hpp"
 
 #include <cstdint>
 #include <string>
@@ -36,23 +36,23 @@ struct Image {
 // colour of the most important class among the leaves that meet it with positive area (boundary over
 // inside over outside), so a cover never loses a boundary cell however small. Outlines are drawn
 // only for cells at least 4 pixels wide; finer cells would merge into solid black.
-Image render(const RssResult& r, PictureKind kind, int pixels);
+Image render(const Cover& r, PictureKind kind, int pixels);
 
 // PNG files (libpng). Throw std::runtime_error naming the path and the reason on I/O failure.
 void write_png(const Image& image, const std::string& path);
-void write_png(const RssResult& r, const std::string& path, PictureKind kind, int pixels);
+void write_png(const Cover& r, const std::string& path, PictureKind kind, int pixels);
 
 // Plain SVG, one rect per drawn cell, grouped by level and class. The process picture skips the
 // levels whose cells are smaller than 0.3 units of its 1024-unit panel (their undecided parents
 // already show the region in the boundary colour); the cover picture draws every inside and
 // boundary leaf (outside leaves are the white background). Throws std::runtime_error on I/O failure.
-void write_svg(const RssResult& r, const std::string& path, PictureKind kind);
+void write_svg(const Cover& r, const std::string& path, PictureKind kind);
 
 // A coarse rendering for golden tests: `rows` lines of `columns` characters, each ended by '\n',
 // top line = highest y. Each character covers an equal part of the root box and shows the leaves
 // that meet that part with positive area: '+' if one is a boundary cell, else ':' if there are both
 // inside and outside cells, '#' if all are inside, '.' if all are outside. columns and rows in
 // [1, 4096].
-std::string ascii_picture(const RssResult& r, int columns, int rows);
+std::string ascii_picture(const Cover& r, int columns, int rows);
 
 } // namespace frac::rt

@@ -8,7 +8,7 @@
 
 namespace frac::rt {
 
-Image relief_image(const RssResult& r, int pixels) {
+Image relief_image(const Cover& r, int pixels) {
     if (r.dimension() != 3 || r.cells.empty())
         throw std::invalid_argument("relief_image: needs a 3D cover computed with its cells");
     if (pixels < 16 || pixels > 16384)

@@ -4,14 +4,14 @@
 // Boundary cells are tinted, so the undecided shell shows where the cover is not yet resolved.
 #pragma once
 
+#include "runtime/cover.hpp"
 #include "runtime/picture.hpp"
-#include "runtime/rss.hpp"
 
 namespace frac::rt {
 
 // The relief of a 3D result computed with keep_cells; `pixels` in [16, 16384] is the longer side (the
 // image has the x:y aspect of the root box). Throws std::invalid_argument for a 2D result or one
 // without cells.
-Image relief_image(const RssResult& r, int pixels);
+Image relief_image(const Cover& r, int pixels);
 
 } // namespace frac::rt

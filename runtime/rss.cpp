@@ -27,36 +27,6 @@ struct Pos {
     std::uint32_t variant = 0;
 };
 
-// split^k; exact in 64 bits (and as a double) for split <= 4, k <= 24.
-std::uint64_t ipow(int split, int k) {
-    std::uint64_t n = 1;
-    for (int i = 0; i < k; ++i) n *= static_cast<std::uint64_t>(split);
-    return n;
-}
-
-// Enclosure of the grid point x0 + w * j / n of an axis, w enclosing x1 - x0. Requires upward
-// rounding. j and n are below 2^53, hence exact doubles.
-Interval grid_point(Interval axis, Interval w, std::uint64_t j, std::uint64_t n) {
-    const Interval t =
-        num::div(num::mul(w, Interval(static_cast<double>(j))), Interval(static_cast<double>(n)));
-    return num::add(Interval(axis.lo), t);
-}
-
-// Outward box of cell i of n along an axis. Requires upward rounding. The end points shared by
-// neighbours are computed by the same expression, so hi(cell i) >= lo(cell i+1): no gaps. Clamping
-// to the root keeps the enclosure (the exact grid points lie in the root) and makes the outer
-// cells end exactly on the root's bounds.
-Interval cell_axis(Interval axis, Interval w, std::uint64_t i, std::uint64_t n) {
-    const double lo = i == 0 ? axis.lo : std::max(axis.lo, grid_point(axis, w, i, n).lo);
-    const double hi = i + 1 >= n ? axis.hi : std::min(axis.hi, grid_point(axis, w, i + 1, n).hi);
-    return {lo, hi};
-}
-
-// Enclosure of the root's width along each axis. Requires upward rounding.
-Interval axis_width(Interval axis) {
-    return num::sub(Interval(axis.hi), Interval(axis.lo));
-}
-
 enum class Verdict { inside, outside, undecided };
 
 // See the header for the rules. The NaN test comes first because an interval with a NaN bound
@@ -88,7 +58,7 @@ void validate(const ir::Evaluator& f, const std::vector<Interval>& root, const R
     if (o.depth < 0 || o.depth > max_depth)
         throw std::invalid_argument(
             fmt::format("subdivide: depth {} is out of range [0, {}] in {}D", o.depth, max_depth, d));
-    if (ipow(o.split, o.depth) > (std::uint64_t{1} << 32))
+    if (grid::ipow(o.split, o.depth) > (std::uint64_t{1} << 32))
         throw std::invalid_argument(fmt::format(
             "subdivide: split^depth = {}^{} exceeds 2^32 cells per axis (cell positions are 32-bit)", o.split,
             o.depth));
@@ -108,7 +78,7 @@ public:
                        : std::max(1, static_cast<int>(std::thread::hardware_concurrency()))),
           arena_(threads_) {
         num::UpwardRounding up;
-        for (const Interval& x : r_.root) width_.push_back(axis_width(x));
+        for (const Interval& x : r_.root) width_.push_back(grid::width(x));
         for (int t = 1; t < threads_; ++t) clones_.push_back(f_.clone());
         variants_.emplace_back();
         variants_[0].workers.push_back(&f_);
@@ -131,7 +101,7 @@ public:
     }
 
     void run() {
-        const int depth = r_.options.depth;
+        const int depth = r_.depth;
         r_.levels.assign(static_cast<std::size_t>(depth) + 1, LevelCounts{});
         last_progress_ = Clock::now();
 
@@ -157,7 +127,7 @@ public:
 private:
     void start_level(int k) {
         level_ = k;
-        n_ = ipow(r_.options.split, k);
+        n_ = grid::ipow(r_.split, k);
         // The level's grid points per axis, computed once (each cell would otherwise compute two per
         // axis with three interval operations each); the same expression, so the same boxes.
         grid_.assign(n_ <= grid_table_limit ? static_cast<std::size_t>(d_) : 0, {});
@@ -165,13 +135,13 @@ private:
         num::UpwardRounding up;
         for (std::size_t a = 0; a < grid_.size(); ++a) {
             grid_[a].resize(n_ + 1);
-            for (std::uint64_t j = 0; j <= n_; ++j) grid_[a][j] = grid_point(r_.root[a], width_[a], j, n_);
+            for (std::uint64_t j = 0; j <= n_; ++j) grid_[a][j] = grid::point(r_.root[a], width_[a], j, n_);
         }
     }
 
     // Outward box of cell i of the level along `axis` (cell_axis, from the level's table when it has one).
     Interval cell_interval(std::size_t axis, std::uint32_t i) const {
-        if (grid_.empty()) return cell_axis(r_.root[axis], width_[axis], i, n_);
+        if (grid_.empty()) return grid::cell(r_.root[axis], width_[axis], i, n_);
         const Interval root = r_.root[axis];
         return {i == 0 ? root.lo : std::max(root.lo, grid_[axis][i].lo),
                 i + 1 >= n_ ? root.hi : std::min(root.hi, grid_[axis][i + 1].hi)};
@@ -187,7 +157,7 @@ private:
     // order: the children of one parent row fill `split` child rows, each running over all the
     // parents of the row; likewise for slabs of constant iz in 3D. Linear time, no sort.
     void push_children(const std::vector<Pos>& parents) {
-        const auto s = static_cast<std::uint32_t>(r_.options.split);
+        const auto s = static_cast<std::uint32_t>(r_.split);
         const std::uint32_t sz = d_ == 3 ? s : 1;
         for (std::size_t slab = 0; slab < parents.size();) {
             std::size_t slab_end = slab;
@@ -238,8 +208,8 @@ private:
         }
         evaluate(m);
 
-        const bool last = level_ == r_.options.depth;
-        const int remaining = r_.options.depth - level_;
+        const bool last = level_ == r_.depth;
+        const int remaining = r_.depth - level_;
         const bool consider_pruning = remaining >= prune_min_remaining && level_ % prune_period == 0;
         LevelCounts& lc = r_.levels[static_cast<std::size_t>(level_)];
         for (std::size_t j = 0; j < m; ++j) {
@@ -350,7 +320,7 @@ private:
     // boundary through it is a smooth curve or surface: split^d children, then split^(d-1) times
     // more cells per level.
     double expected_descendants(int remaining) const {
-        const double s = r_.options.split;
+        const double s = r_.split;
         double per_level = std::pow(s, d_), total = 0;
         for (int j = 0; j < remaining; ++j, per_level *= std::pow(s, d_ - 1)) total += per_level;
         return total;
@@ -360,7 +330,7 @@ private:
     // function when the evaluator offers one (the same function always maps to the same variant).
     std::uint32_t pruned_variant(std::uint32_t v, const Interval* box) {
         ir::Evaluator& e = *variants_[v].workers[0];
-        std::shared_ptr<ir::Evaluator> p = e.specialize(box, expected_descendants(r_.options.depth - level_));
+        std::shared_ptr<ir::Evaluator> p = e.specialize(box, expected_descendants(r_.depth - level_));
         if (!p) return v;
         auto [it, added] = variant_of_.try_emplace(p.get(), static_cast<std::uint32_t>(variants_.size()));
         if (added) {
@@ -408,35 +378,17 @@ private:
 
 } // namespace
 
-std::uint64_t RssResult::cells_per_axis(int level) const {
-    return ipow(options.split, level);
-}
-
-Interval RssResult::cell_interval(const Cell& c, int axis) const {
-    if (axis < 0 || axis >= dimension())
-        throw std::out_of_range(fmt::format("cell_interval: axis {} of a {}D box", axis, dimension()));
-    const std::uint32_t i = axis == 0 ? c.ix : axis == 1 ? c.iy : c.iz;
-    const Interval x = root[static_cast<std::size_t>(axis)];
-    num::UpwardRounding up;
-    return cell_axis(x, axis_width(x), i, cells_per_axis(c.level));
-}
-
 RssResult subdivide(ir::Evaluator& f, const std::vector<Interval>& root, const RssOptions& options) {
     validate(f, root, options);
     const auto start = Clock::now();
     RssResult r;
     r.root = root;
+    r.depth = options.depth;
+    r.split = options.split;
     r.options = options;
     Runner(f, r).run();
     r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
     return r;
-}
-
-bool same_cover(const RssResult& a, const RssResult& b) {
-    return std::equal(
-        a.cells.begin(), a.cells.end(), b.cells.begin(), b.cells.end(), [](const Cell& x, const Cell& y) {
-            return x.level == y.level && x.cls == y.cls && x.ix == y.ix && x.iy == y.iy && x.iz == y.iz;
-        });
 }
 
 } // namespace frac::rt

@@ -19,6 +19,7 @@
 #pragma once
 
 #include "ir/evaluator.hpp"
+#include "runtime/cover.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -26,17 +27,6 @@
 #include <vector>
 
 namespace frac::rt {
-
-using num::Interval;
-
-enum class CellClass : std::uint8_t { inside, outside, boundary, subdivided };
-
-// A cell of the subdivision: level k, integer position ix, iy (and iz) in the 2^k (or split^k) grid.
-struct Cell {
-    std::uint8_t level = 0;
-    CellClass cls = CellClass::boundary;
-    std::uint32_t ix = 0, iy = 0, iz = 0;
-};
 
 // Called after each completed level and, during a long level, after a batch when at least a second
 // has passed since the previous call. `level` is the level being evaluated, `evaluated` the number
@@ -73,40 +63,17 @@ inline constexpr int prune_period = 1;
 inline constexpr int max_depth_2d = 24;
 inline constexpr int max_depth_3d = 14;
 
-struct LevelCounts {
-    std::uint64_t evaluated = 0, inside = 0, outside = 0, undecided = 0;
-};
-
-struct RssResult {
-    std::vector<Interval> root; // the root box, one interval per axis
+// A subdivision's cover (depth and split from its options) with what the run measured.
+struct RssResult : Cover {
     RssOptions options;
-    // Every evaluated cell, when keep_cells: ordered by level, then within a level by position
-    // (iz, then iy, then ix: row-major, x fastest).
-    std::vector<Cell> cells;
-    std::vector<LevelCounts> levels; // index = level, 0..depth
-    // Totals over all levels; evaluated = inside + outside + boundary + subdivided.
-    std::uint64_t evaluated = 0, inside = 0, outside = 0, boundary = 0, subdivided = 0;
     double seconds = 0; // wall time of subdivide (steady clock)
     // Pruning: cells evaluated with a simplified function, and how many distinct functions they used.
     std::uint64_t pruned_evaluations = 0;
     std::size_t specializations = 0;
-
-    // Outward enclosure of a cell's box along `axis`: lo = RD(x0 + (x1-x0)*i/n),
-    // hi = RU(x0 + (x1-x0)*(i+1)/n), n = split^level, clamped to the root box. Neighbouring cells
-    // overlap (or touch) rather than leave gaps. Sets upward rounding itself.
-    Interval cell_interval(const Cell& c, int axis) const;
-    // Number of axes (2 or 3).
-    int dimension() const { return static_cast<int>(root.size()); }
-    // split^level: the number of cells per axis at `level`.
-    std::uint64_t cells_per_axis(int level) const;
 };
 
 // Throws std::invalid_argument on a bad depth/split/batch or a box of the wrong dimension (the
 // root must have 2 or 3 axes, as many as f.dimension(), each finite with lo < hi).
 RssResult subdivide(ir::Evaluator& f, const std::vector<Interval>& root, const RssOptions& options);
-
-// Whether two results recorded the same cells (level, class and position, in the same order): the
-// same cover, e.g. with pruning on and off, or with two engines.
-bool same_cover(const RssResult& a, const RssResult& b);
 
 } // namespace frac::rt

@@ -17,7 +17,7 @@ std::uint32_t coord(const Cell& c, int axis) {
 
 } // namespace
 
-RssResult slice(const RssResult& r, double value, int axis) {
+Cover slice(const Cover& r, double value, int axis) {
     if (r.dimension() != 3) throw std::invalid_argument("slice needs a 3D cover");
     if (r.cells.empty())
         throw std::invalid_argument("slice needs the cells: run subdivide with keep_cells = true");
@@ -32,7 +32,7 @@ RssResult slice(const RssResult& r, double value, int axis) {
 
     // Per level, the positions along `axis` whose outward cell box holds the value: the grid cell
     // of the value and its neighbours, tested with the same boxes as the subdivision used.
-    const int depth = r.options.depth;
+    const int depth = r.depth;
     std::vector<std::array<std::int64_t, 3>> hit(static_cast<std::size_t>(depth) + 1);
     for (int k = 0; k <= depth; ++k) {
         const std::uint64_t n = r.cells_per_axis(k);
@@ -51,11 +51,10 @@ RssResult slice(const RssResult& r, double value, int axis) {
         }
     }
 
-    RssResult s;
+    Cover s;
     s.root = {r.root[static_cast<std::size_t>(au)], r.root[static_cast<std::size_t>(av)]};
-    s.options = r.options;
-    s.options.keep_cells = true;
-    s.options.progress = nullptr;
+    s.depth = r.depth;
+    s.split = r.split;
     for (const Cell& c : r.cells) {
         if (c.level > depth) continue;
         const auto& h = hit[c.level];
@@ -84,7 +83,7 @@ RssResult slice(const RssResult& r, double value, int axis) {
     return s;
 }
 
-void write_slice_png(const RssResult& r, double value, const std::string& path, PictureKind kind, int pixels,
+void write_slice_png(const Cover& r, double value, const std::string& path, PictureKind kind, int pixels,
                      int axis) {
     write_png(slice(r, value, axis), path, kind, pixels);
 }

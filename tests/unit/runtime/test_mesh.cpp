@@ -3,6 +3,7 @@
 // sponge with its exact Euler characteristic; the checker on broken meshes; the writers.
 #include "mesh_euler.hpp"
 #include "runtime/mesh.hpp"
+#include "runtime/rss.hpp"
 #include "test_mesh_shapes.hpp"
 
 #include <catch2/catch.hpp>

@@ -1,6 +1,7 @@
 // The relief of a 3D cover: pixels over the shape are drawn, the rest stays white; a flat top is
 // evenly lit, a ball is lit from the upper left (its upper-left flank brighter than the lower right).
 #include "runtime/relief.hpp"
+#include "runtime/rss.hpp"
 #include "shapes.hpp"
 
 #include <catch2/catch.hpp>

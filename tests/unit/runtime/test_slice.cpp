@@ -1,5 +1,6 @@
 // Slices of 3D covers: the cells meeting a plane, their placement and classes, the plane on a grid
 // boundary (both sides), the three axes, PNG output and argument errors.
+#include "runtime/rss.hpp"
 #include "runtime/slice.hpp"
 #include "test_mesh_shapes.hpp"
 
@@ -43,7 +44,7 @@ TEST_CASE("slice: a layer of the level-2 sponge, one character per cell", "[slic
     const RssResult r = subdivide(s, cube(0, 9), opts(2, 3));
 
     // z = 4.5 cuts the unit layer z in [4, 5] only.
-    const RssResult v = slice(r, 4.5);
+    const Cover v = slice(r, 4.5);
     CHECK(v.dimension() == 2);
     CHECK(v.root[0] == Interval(0, 9));
     CHECK(v.levels[0].evaluated == 1);
@@ -61,7 +62,7 @@ TEST_CASE("slice: a layer of the level-2 sponge, one character per cell", "[slic
 
     // z = 3 lies between the layers 2 and 3: the cells of both meet it. A character is '#' only when
     // both cubes are inside.
-    const RssResult w = slice(r, 3.0);
+    const Cover w = slice(r, 3.0);
     want.clear();
     for (int y = 8; y >= 0; --y) {
         for (int x = 0; x < 9; ++x) {
@@ -88,7 +89,7 @@ TEST_CASE("slice: the three axes of a ball give the same picture", "[slice]") {
     CHECK(c[0] == '.');
     CHECK(c.find('+') != std::string::npos);
     // At the top of the box the ball is far: all outside.
-    const RssResult top = slice(r, 1.0);
+    const Cover top = slice(r, 1.0);
     CHECK(top.inside == 0);
     CHECK(top.boundary == 0);
 }

@@ -1,0 +1,55 @@
+#include "runtime/cover.hpp"
+
+#include <algorithm>
+#include <fmt/format.h>
+#include <stdexcept>
+
+namespace frac::rt {
+
+namespace grid {
+
+std::uint64_t ipow(int split, int k) {
+    std::uint64_t n = 1;
+    for (int i = 0; i < k; ++i) n *= static_cast<std::uint64_t>(split);
+    return n;
+}
+
+Interval point(Interval axis, Interval w, std::uint64_t j, std::uint64_t n) {
+    const Interval t =
+        num::div(num::mul(w, Interval(static_cast<double>(j))), Interval(static_cast<double>(n)));
+    return num::add(Interval(axis.lo), t);
+}
+
+Interval cell(Interval axis, Interval w, std::uint64_t i, std::uint64_t n) {
+    const double lo = i == 0 ? axis.lo : std::max(axis.lo, point(axis, w, i, n).lo);
+    const double hi = i + 1 >= n ? axis.hi : std::min(axis.hi, point(axis, w, i + 1, n).hi);
+    return {lo, hi};
+}
+
+Interval width(Interval axis) {
+    return num::sub(Interval(axis.hi), Interval(axis.lo));
+}
+
+} // namespace grid
+
+std::uint64_t Cover::cells_per_axis(int level) const {
+    return grid::ipow(split, level);
+}
+
+Interval Cover::cell_interval(const Cell& c, int axis) const {
+    if (axis < 0 || axis >= dimension())
+        throw std::out_of_range(fmt::format("cell_interval: axis {} of a {}D box", axis, dimension()));
+    const std::uint32_t i = axis == 0 ? c.ix : axis == 1 ? c.iy : c.iz;
+    const Interval x = root[static_cast<std::size_t>(axis)];
+    num::UpwardRounding up;
+    return grid::cell(x, grid::width(x), i, cells_per_axis(c.level));
+}
+
+bool same_cover(const Cover& a, const Cover& b) {
+    return std::equal(
+        a.cells.begin(), a.cells.end(), b.cells.begin(), b.cells.end(), [](const Cell& x, const Cell& y) {
+            return x.level == y.level && x.cls == y.cls && x.ix == y.ix && x.iy == y.iy && x.iz == y.iz;
+        });
+}
+
+} // namespace frac::rt
