@@ -11,6 +11,9 @@
 #include <cmath>
 #include <cstdlib>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <fmt/format.h>
 #include <iostream>
 #include <unistd.h>
@@ -51,8 +54,17 @@ int run_check(const std::string& file, const std::string& emit, const std::strin
                                      jit::emit_llvm(ir::build_tape(m.graph, s->root, s->dimension)));
         }
     }
-    if (emit.empty())
-        std::cout << fmt::format("{}: ok ({} shapes, {} tests)\n", file, m.shapes.size(), m.tests.size());
+    if (emit.empty()) {
+        // The file's own shapes and tests: imported modules' are not its work (file 1 is the main file).
+        const auto own = [](const auto& items) {
+            return std::count_if(items.begin(), items.end(), [](const auto& i) { return i.loc.file == 1; });
+        };
+        const auto counted = [](std::ptrdiff_t n, const char* noun) {
+            return fmt::format("{} {}{}", n, noun, n == 1 ? "" : "s");
+        };
+        std::cout << fmt::format("{}: ok ({}, {})\n", file, counted(own(m.shapes), "shape"),
+                                 counted(own(m.tests), "test"));
+    }
     return 0;
 }
 
@@ -62,19 +74,33 @@ int run_eval(const std::string& file, const std::string& shape, const std::strin
     if (!c) return front::exit_compile_error;
     const front::ShapeInfo& s = find_shape(*c, shape);
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
+    if (at.empty() && box.empty()) throw UsageError("give --at x,y or --box x0:x1,y0:y1");
+    int status = 0;
     if (!at.empty()) {
         std::vector<ir::Interval> enclosure;
         const std::vector<double> p = parse_point(at, s.dimension, &enclosure);
         const double value = eval->eval_point(p.data());
         const ir::Interval proven = eval->eval_box(enclosure.data());
         std::cout << fmt::format("{} = {}\nenclosure {}\n", s.name, value, format_interval(proven));
+        // NaN or an empty enclosure: the function is undefined there (sqrt or log of a negative number...),
+        // which a caller testing the sign of the value must not miss.
+        if (std::isnan(value) || proven.is_empty()) {
+            std::cerr << fmt::format("frac: warning: '{}' is undefined at ({}): {}\n", s.name, at,
+                                     proven.is_empty() ? "its enclosure is empty" : "its value is NaN");
+            status = 1;
+        }
     }
     if (!box.empty()) {
         const auto b = parse_box(box, s.dimension);
-        std::cout << fmt::format("enclosure over the box {}\n", format_interval(eval->eval_box(b.data())));
+        const ir::Interval proven = eval->eval_box(b.data());
+        std::cout << fmt::format("enclosure over the box {}\n", format_interval(proven));
+        if (proven.is_empty()) {
+            std::cerr << fmt::format(
+                "frac: warning: '{}' is undefined over the box {}: its enclosure is empty\n", s.name, box);
+            status = 1;
+        }
     }
-    if (at.empty() && box.empty()) throw RunError("give --at x,y or --box x0:x1,y0:y1");
-    return 0;
+    return status;
 }
 
 namespace {
@@ -123,16 +149,24 @@ void check_output_size(const std::string& path, double bytes, bool force) {
 } // namespace
 
 int run_render(const std::string& file, const RenderOptions& o, const EngineOptions& engine) {
-    if (o.output.empty() && o.ascii.empty()) throw RunError("give -o out.png|out.svg or --ascii COLSxROWS");
+    if (o.output.empty() && o.ascii.empty())
+        throw UsageError("render needs -o FILE.png|FILE.svg or --ascii COLSxROWS");
     rt::PictureKind kind = rt::PictureKind::both;
     if (o.kind == "process")
         kind = rt::PictureKind::process;
     else if (o.kind == "cover")
         kind = rt::PictureKind::cover;
     else if (o.kind != "both")
-        throw RunError(fmt::format("unknown picture kind '{}' (process, cover, both)", o.kind));
+        throw UsageError(fmt::format("unknown picture kind '{}' (process, cover, both)", o.kind));
     if (!o.output.empty() && !ends_with(o.output, ".png") && !ends_with(o.output, ".svg"))
-        throw RunError(fmt::format("cannot tell the picture format of '{}': use .png or .svg", o.output));
+        throw UsageError(fmt::format("cannot tell the picture format of '{}': use .png or .svg", o.output));
+    int cols = 0, rows = 0;
+    if (!o.ascii.empty() && (std::sscanf(o.ascii.c_str(), "%dx%d", &cols, &rows) != 2 || cols < 1 ||
+                             rows < 1 || cols > 1000 || rows > 1000))
+        throw UsageError(
+            fmt::format("--ascii needs COLSxROWS such as 64x32 (1 to 1000 each), not '{}'", o.ascii));
+    if (o.size < 16 || o.size > 8192) throw UsageError("--size must be between 16 and 8192 pixels");
+    if (!o.output.empty()) check_output_writable(o.output);
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
     const front::ShapeInfo& s = pick_shape(*c, o.shape);
@@ -148,13 +182,13 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
         slice_value = std::strtod(value.c_str(), &end);
         if (eq == std::string::npos || slice_axis < 0 || value.empty() || *end != '\0' ||
             !std::isfinite(slice_value))
-            throw RunError(fmt::format("--slice needs AXIS=VALUE such as z=0.5, not '{}'", o.slice));
-        if (s.dimension != 3) throw RunError(fmt::format("--slice is for 3D shapes; '{}' is 2D", s.name));
+            throw UsageError(fmt::format("--slice needs AXIS=VALUE such as z=0.5, not '{}'", o.slice));
+        if (s.dimension != 3) throw UsageError(fmt::format("--slice is for 3D shapes; '{}' is 2D", s.name));
     }
     if (s.dimension == 3 && slice_axis < 0 && (!o.ascii.empty() || ends_with(o.output, ".svg")))
-        throw RunError(fmt::format("shape '{}' is 3D: draw a section with --slice z=VALUE, or a relief "
-                                   "(shaded depth image) as .png",
-                                   s.name));
+        throw UsageError(fmt::format("shape '{}' is 3D: draw a section with --slice z=VALUE, or a relief "
+                                     "(shaded depth image) as .png",
+                                     s.name));
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
     const rt::RssResult full = cover(box, o.depth, o.split, true, engine.threads, *eval);
@@ -162,7 +196,6 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
         "{}: depth {}, {} boxes evaluated: {} inside, {} outside, {} boundary; {:.3f} s\n", s.name, o.depth,
         full.evaluated, full.inside, full.outside, full.boundary, full.seconds);
     if (s.dimension == 3 && slice_axis < 0) {
-        if (o.size < 16 || o.size > 8192) throw RunError("--size must be between 16 and 8192 pixels");
         try {
             rt::write_png(rt::relief_image(full, o.size), o.output);
         } catch (const std::runtime_error& e) {
@@ -175,19 +208,12 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
     if (slice_axis >= 0) {
         if (!(slice_value >= box[static_cast<std::size_t>(slice_axis)].lo &&
               slice_value <= box[static_cast<std::size_t>(slice_axis)].hi))
-            throw RunError(fmt::format("--slice {}: the value lies outside the box", o.slice));
+            throw UsageError(fmt::format("--slice {}: the value lies outside the box", o.slice));
         section = rt::slice(full, slice_value, slice_axis);
     }
     const rt::Cover& r = slice_axis >= 0 ? section : static_cast<const rt::Cover&>(full);
-    if (!o.ascii.empty()) {
-        int cols = 0, rows = 0;
-        if (std::sscanf(o.ascii.c_str(), "%dx%d", &cols, &rows) != 2 || cols < 1 || rows < 1 || cols > 1000 ||
-            rows > 1000)
-            throw RunError(fmt::format("--ascii needs COLSxROWS such as 64x32, not '{}'", o.ascii));
-        std::cout << rt::ascii_picture(r, cols, rows);
-    }
+    if (!o.ascii.empty()) std::cout << rt::ascii_picture(r, cols, rows);
     if (!o.output.empty()) {
-        if (o.size < 16 || o.size > 8192) throw RunError("--size must be between 16 and 8192 pixels");
         try {
             if (ends_with(o.output, ".png")) {
                 rt::write_png(r, o.output, kind, o.size);
@@ -229,21 +255,24 @@ int run_dimension(const std::string& file, const std::string& shape, int from, i
 }
 
 int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions& engine) {
-    if (o.output.empty()) throw RunError("give -o out.stl|out.obj|out.ply");
+    if (o.output.empty()) throw UsageError("mesh needs -o FILE.stl|FILE.obj|FILE.ply");
     if (!ends_with(o.output, ".stl") && !ends_with(o.output, ".obj") && !ends_with(o.output, ".ply"))
-        throw RunError(fmt::format("cannot tell the mesh format of '{}': use .stl, .obj or .ply", o.output));
+        throw UsageError(
+            fmt::format("cannot tell the mesh format of '{}': use .stl, .obj or .ply", o.output));
     rt::MeshSelection selection = rt::MeshSelection::inside;
     if (o.select == "cover")
         selection = rt::MeshSelection::inside_and_boundary;
     else if (o.select == "boundary")
         selection = rt::MeshSelection::boundary;
     else if (o.select != "inside")
-        throw RunError(fmt::format("unknown selection '{}': use inside, cover or boundary", o.select));
+        throw UsageError(fmt::format("unknown selection '{}': use inside, cover or boundary", o.select));
+    check_output_writable(o.output);
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
     const front::ShapeInfo& s = pick_shape(*c, o.shape);
     if (s.dimension != 3)
-        throw RunError(fmt::format("shape '{}' is {}D; meshes are of 3D shapes", s.name, s.dimension));
+        throw UsageError(fmt::format("shape '{}' is {}D; meshes are of 3D shapes (frac render draws 2D ones)",
+                                     s.name, s.dimension));
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
     // A mesh is of the closed solid {f <= 0}: cells whose faces lie on its surface are inside.

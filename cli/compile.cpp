@@ -137,7 +137,7 @@ std::vector<jit::AotShape> chosen_shapes(const front::Compilation& c, const std:
     std::vector<const front::ShapeInfo*> infos;
     if (names.empty()) {
         for (const front::ShapeInfo& s : c.module.shapes) infos.push_back(&s);
-        if (infos.empty()) throw RunError("the model defines no shape");
+        if (infos.empty()) throw UsageError("the model defines no shape");
     } else {
         for (const std::string& n : names) {
             const front::ShapeInfo* s = &find_shape(c, n);
@@ -163,13 +163,15 @@ std::string check_compile_output(const std::string& path) {
 }
 
 int run_compile(const std::string& file, const CompileOptions& o) {
-    if (std::string problem = check_compile_output(o.output); !problem.empty()) throw RunError(problem);
+    if (std::string problem = check_compile_output(o.output); !problem.empty()) throw UsageError(problem);
+    for (const std::string& path : {o.output, o.header})
+        if (!path.empty()) check_output_writable(path);
     jit::AotConfig config;
     config.options.max_terms = o.max_terms;
     config.cpu = o.cpu;
     config.prefix = o.prefix;
     if (!jit::is_c_identifier(config.prefix + "x"))
-        throw RunError(fmt::format("--prefix '{}' cannot begin a C identifier", config.prefix));
+        throw UsageError(fmt::format("--prefix '{}' cannot begin a C identifier", config.prefix));
 
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;

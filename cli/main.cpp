@@ -1,5 +1,6 @@
 // frac: the command-line tool. Thin: it wires the frontend, the engines and the runtime together.
 #include "cli/commands.hpp"
+#include "frontend/suggest.hpp"
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -8,20 +9,34 @@
 
 int main(int argc, char** argv) {
     using namespace frac;
-    CLI::App app{"frac: fractal geometric modeling with guaranteed interval evaluation"};
+    CLI::App app{"frac: fractal geometric modeling with guaranteed interval evaluation", "frac"};
     app.require_subcommand(1);
+    app.set_version_flag("--version", fmt::format("frac {} (LLVM {})", FRAC_VERSION, FRAC_LLVM_VERSION),
+                         "print the version of frac and of the LLVM it uses, then exit");
     cli::EngineOptions engine;
+    // Constant overrides, NAME=VALUE, applied to the model before it is compiled.
+    std::vector<std::string> sets;
+    auto add_set = [&](CLI::App* sub) {
+        sub->add_option("--set", sets, "override a constant of the model: NAME=VALUE (repeatable)")
+            ->type_name("NAME=VALUE")
+            ->allow_extra_args(false);
+    };
     auto add_engine = [&](CLI::App* sub) {
-        sub->add_option("--engine", engine.engine, "evaluation engine: jit (default) or interp")
-            ->check(CLI::IsMember({"jit", "interp"}));
+        sub->add_option("--engine", engine.engine, "evaluation engine: jit or interp")
+            ->check(CLI::IsMember({"jit", "interp"}))
+            ->capture_default_str();
         sub->add_option("--max-terms", engine.eval.max_terms,
                         "most terms of an infinite series before its tail bound")
-            ->check(CLI::Range(1, ir::max_terms_limit));
+            ->check(CLI::Range(1, ir::max_terms_limit))
+            ->capture_default_str();
         sub->add_option("--threads", engine.threads, "subdivision threads (0: all cores)")
-            ->check(CLI::Range(0, 1024));
+            ->check(CLI::Range(0, 1024))
+            ->capture_default_str();
         sub->add_option("--prune", engine.eval.prune,
-                        "min/max pruning per region during subdivision: on (default) or off")
-            ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
+                        "min/max pruning per region during subdivision: on or off")
+            ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}))
+            ->default_str("on");
+        add_set(sub);
     };
 
     std::string file, shape, emit, at, box;
@@ -30,6 +45,7 @@ int main(int argc, char** argv) {
     check->add_option("--emit", emit, "print the ast, the ir graph, the tape or the JIT's LLVM IR")
         ->check(CLI::IsMember({"ast", "ir", "tape", "llvm"}));
     check->add_option("--shape", shape, "only this shape");
+    add_set(check);
 
     auto* eval = app.add_subcommand("eval", "evaluate a shape at a point or over a box");
     eval->add_option("file", file, "model file")->required();
@@ -43,12 +59,20 @@ int main(int argc, char** argv) {
         "render", "cover a shape by recursive subdivision and draw it (3D: a section or a shaded relief)");
     render->add_option("file", file, "model file")->required();
     render->add_option("shape", render_options.shape, "shape name (default: the last shape of the file)");
-    render->add_option("--depth", render_options.depth, "subdivision depth")->check(CLI::Range(0, 64));
-    render->add_option("--split", render_options.split, "parts per axis and level")->check(CLI::Range(2, 4));
+    render->add_option("--depth", render_options.depth, "subdivision depth")
+        ->check(CLI::Range(0, 64))
+        ->capture_default_str();
+    render->add_option("--split", render_options.split, "parts per axis and level")
+        ->check(CLI::Range(2, 4))
+        ->capture_default_str();
     render->add_option("--box", render_options.box, "view box x0:x1,y0:y1 (default: the shape's)");
     render->add_option("-o,--output", render_options.output, "picture file, .png or .svg");
-    render->add_option("--kind", render_options.kind, "process, cover or both (side by side)");
-    render->add_option("--size", render_options.size, "pixels per panel (PNG)");
+    render->add_option("--kind", render_options.kind, "process, cover or both (side by side)")
+        ->check(CLI::IsMember({"process", "cover", "both"}))
+        ->capture_default_str();
+    render->add_option("--size", render_options.size, "pixels per panel (PNG)")
+        ->check(CLI::Range(16, 8192))
+        ->capture_default_str();
     render->add_option("--ascii", render_options.ascii, "also print a COLSxROWS character picture");
     render->add_flag("--force", render_options.force, "write an SVG estimated above 100 MB");
     render->add_option(
@@ -62,12 +86,18 @@ int main(int argc, char** argv) {
         app.add_subcommand("mesh", "cover a 3D shape by an octree and write a watertight mesh of it");
     mesh->add_option("file", file, "model file")->required();
     mesh->add_option("shape", mesh_options.shape, "shape name (default: the last shape of the file)");
-    mesh->add_option("--depth", mesh_options.depth, "subdivision depth")->check(CLI::Range(0, 64));
-    mesh->add_option("--split", mesh_options.split, "parts per axis and level")->check(CLI::Range(2, 4));
+    mesh->add_option("--depth", mesh_options.depth, "subdivision depth")
+        ->check(CLI::Range(0, 64))
+        ->capture_default_str();
+    mesh->add_option("--split", mesh_options.split, "parts per axis and level")
+        ->check(CLI::Range(2, 4))
+        ->capture_default_str();
     mesh->add_option("--box", mesh_options.box, "box x0:x1,y0:y1,z0:z1 (default: the shape's)");
     mesh->add_option("--select", mesh_options.select,
                      "inside: the proven-inside cells; cover: inside and boundary cells; boundary: the "
-                     "boundary cells (a thin solid around the surface)");
+                     "boundary cells (a thin solid around the surface)")
+        ->check(CLI::IsMember({"inside", "cover", "boundary"}))
+        ->capture_default_str();
     mesh->add_option("-o,--output", mesh_options.output, "mesh file: .stl (binary), .obj or .ply");
     mesh->add_flag("--force", mesh_options.force, "write a mesh estimated above 100 MB");
     add_engine(mesh);
@@ -77,9 +107,15 @@ int main(int argc, char** argv) {
         app.add_subcommand("dimension", "box-counting dimension of a shape's boundary from its cover");
     dimension->add_option("file", file, "model file")->required();
     dimension->add_option("shape", shape, "shape name (default: the last shape of the file)");
-    dimension->add_option("--from", from, "first level of the fit")->check(CLI::Range(0, 64));
-    dimension->add_option("--to", to, "last level (the subdivision depth)")->check(CLI::Range(1, 64));
-    dimension->add_option("--split", split, "parts per axis and level")->check(CLI::Range(2, 4));
+    dimension->add_option("--from", from, "first level of the fit")
+        ->check(CLI::Range(0, 64))
+        ->capture_default_str();
+    dimension->add_option("--to", to, "last level (the subdivision depth)")
+        ->check(CLI::Range(1, 64))
+        ->capture_default_str();
+    dimension->add_option("--split", split, "parts per axis and level")
+        ->check(CLI::Range(2, 4))
+        ->capture_default_str();
     add_engine(dimension);
 
     std::vector<std::string> files;
@@ -105,19 +141,48 @@ int main(int argc, char** argv) {
     compile
         ->add_option("--max-terms", compile_options.max_terms,
                      "most terms of an infinite series before its tail bound (baked into the code)")
-        ->check(CLI::Range(1, ir::max_terms_limit));
-    compile->add_option("--cpu", compile_options.cpu,
-                        "generic (default: any CPU of this architecture), native (this host) or an LLVM CPU "
-                        "name such as x86-64-v3, x86-64-v4");
-    compile->add_option("--prefix", compile_options.prefix, "prefix of the exported C names (default frac_)");
+        ->check(CLI::Range(1, ir::max_terms_limit))
+        ->capture_default_str();
+    compile
+        ->add_option("--cpu", compile_options.cpu,
+                     "generic (any CPU of this architecture), native (this host) or an LLVM CPU name such as "
+                     "x86-64-v3, x86-64-v4")
+        ->capture_default_str();
+    compile->add_option("--prefix", compile_options.prefix, "prefix of the exported C names")
+        ->capture_default_str();
+    add_set(compile);
+
+    // `frac help [COMMAND]`: the text of `frac [COMMAND] --help`.
+    std::string help_topic;
+    auto* help = app.add_subcommand("help", "print the help of frac or of one command");
+    help->add_option("command", help_topic, "a command");
 
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         const int code = app.exit(e);
-        return code == 0 ? 0 : 64; // EX_USAGE for every malformed command line
+        return code == 0 ? 0 : front::exit_usage_error;
     }
     try {
+        if (*help) {
+            if (help_topic.empty()) {
+                // app.help() would describe the selected subcommand, `help` itself.
+                std::cout << app.get_formatter()->make_help(&app, app.get_name(), CLI::AppFormatMode::Normal);
+                return 0;
+            }
+            for (const CLI::App* sub : app.get_subcommands({}))
+                if (sub->get_name() == help_topic) {
+                    std::cout << sub->help(app.get_name());
+                    return 0;
+                }
+            std::vector<std::string> names;
+            for (const CLI::App* sub : app.get_subcommands({})) names.push_back(sub->get_name());
+            const auto near = front::closest_name(help_topic, names);
+            throw cli::UsageError(fmt::format("no command '{}'{}; the commands: {}", help_topic,
+                                              near ? fmt::format(" (did you mean '{}'?)", *near) : "",
+                                              front::list_names(names)));
+        }
+        cli::set_constant_overrides(sets);
         if (*check) return cli::run_check(file, emit, shape);
         if (*eval) return cli::run_eval(file, shape, at, box, engine);
         if (*render) return cli::run_render(file, render_options, engine);
@@ -126,6 +191,9 @@ int main(int argc, char** argv) {
         if (*test) return cli::run_tests(files, false, engine);
         if (*compile) return cli::run_compile(file, compile_options);
         if (*run) return cli::run_tests({file}, true, engine);
+    } catch (const cli::UsageError& e) {
+        std::cerr << "frac: error: " << e.what() << "\n";
+        return front::exit_usage_error;
     } catch (const cli::RunError& e) {
         std::cerr << "frac: error: " << e.what() << "\n";
         return front::exit_runtime_error;

@@ -5,14 +5,51 @@
 #include "runtime/dimension.hpp"
 #include "runtime/rss.hpp"
 
+#include "frontend/suggest.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <fmt/format.h>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 
 namespace frac::cli {
 
+namespace {
+front::ConstOverrides constant_overrides;
+} // namespace
+
+void set_constant_overrides(const std::vector<std::string>& sets) {
+    constant_overrides.clear();
+    for (const std::string& set : sets) {
+        const std::size_t eq = set.find('=');
+        const std::string name = eq == std::string::npos ? "" : set.substr(0, eq);
+        if (name.empty() || !front::is_identifier(name))
+            throw UsageError(
+                fmt::format("--set needs NAME=VALUE (a constant of the model and its value), not '{}'", set));
+        const std::string value = set.substr(eq + 1);
+        (void)evaluate_constant(value,
+                                fmt::format("--set {}: the value", name)); // a constant, or a usage error
+        constant_overrides.push_back({name, value});
+    }
+}
+
 std::unique_ptr<front::Compilation> compile_or_report(const std::string& path, front::StopAfter stop) {
-    auto c = front::compile_file(path, {}, stop);
+    auto c = front::compile_file(path, {}, stop, constant_overrides);
+    if (!c->unknown_overrides.empty()) {
+        // A --set of a constant the model lacks is a command-line mistake, reported before any diagnostic.
+        const std::string& name = c->unknown_overrides.front();
+        std::vector<std::string> consts;
+        for (const front::Item& it : c->program.items)
+            if (it.kind == front::ItemKind::const_) consts.push_back(it.name);
+        const auto near = front::closest_name(name, consts);
+        throw UsageError(fmt::format("--set {}: the model has no constant '{}'{} (constants: {})", name, name,
+                                     near ? fmt::format("; did you mean '{}'?", *near) : "",
+                                     front::list_names(consts)));
+    }
     if (!c->ok()) {
         std::cerr << c->diags.render(c->sources);
         const std::size_t n = c->diags.error_count();
@@ -25,15 +62,17 @@ std::unique_ptr<front::Compilation> compile_or_report(const std::string& path, f
 
 const front::ShapeInfo& find_shape(const front::Compilation& c, const std::string& name) {
     if (const front::ShapeInfo* s = c.module.find_shape(name)) return *s;
-    std::string known;
-    for (const auto& s : c.module.shapes) known += (known.empty() ? "" : ", ") + s.name;
-    throw RunError(
-        fmt::format("no shape '{}' in the model (shapes: {})", name, known.empty() ? "none" : known));
+    std::vector<std::string> known;
+    for (const auto& s : c.module.shapes) known.push_back(s.name);
+    const auto near = front::closest_name(name, known);
+    throw UsageError(fmt::format("no shape '{}' in the model{} (shapes: {})", name,
+                                 near ? fmt::format("; did you mean '{}'?", *near) : "",
+                                 front::list_names(known)));
 }
 
 const front::ShapeInfo& pick_shape(const front::Compilation& c, const std::string& name) {
     if (!name.empty()) return find_shape(c, name);
-    if (c.module.shapes.empty()) throw RunError("the model defines no shape");
+    if (c.module.shapes.empty()) throw UsageError("the model defines no shape");
     // The last shape of the main file: imported libraries come first.
     return c.module.shapes.back();
 }
@@ -72,30 +111,66 @@ std::vector<std::string> split(const std::string& text, char sep) {
     return parts;
 }
 
-ir::Interval parse_number(const std::string& text) {
-    std::size_t used = 0;
-    try {
-        (void)std::stod(text, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used == 0 || used != text.size()) throw RunError(fmt::format("'{}' is not a number", text));
-    return num::from_decimal(text);
+std::string point_form(int dimension) {
+    return dimension == 2 ? "x,y" : dimension == 3 ? "x,y,z" : fmt::format("{} numbers", dimension);
+}
+std::string box_form(int dimension) {
+    return dimension == 2   ? "x0:x1,y0:y1"
+           : dimension == 3 ? "x0:x1,y0:y1,z0:z1"
+                            : fmt::format("{} intervals lo:hi", dimension);
 }
 
 } // namespace
 
+ConstantValue evaluate_constant(const std::string& text, const std::string& what) {
+    // The text is the body of a constant of an otherwise empty model: the language's own parser,
+    // name resolution and constant checks apply, and nothing of the user's model is in scope.
+    const std::string source = "const value = " + text + ";\nprint value;\n";
+    auto c = front::compile_source("<command line>", source);
+    if (!c->ok() || c->program.items.size() != 2 || c->module.prints.size() != 1 ||
+        c->module.prints[0].kind != front::ValueKind::scalar) {
+        std::string why = "not a number";
+        for (const front::Diagnostic& d : c->diags.all())
+            if (d.severity == front::Severity::error) {
+                why = d.message;
+                break;
+            }
+        throw UsageError(fmt::format("{} '{}' is not a constant expression ({}); write a number or an "
+                                     "expression of numbers such as 1/3, 2^-3, sqrt(2)/2, pi/4",
+                                     what, text, why));
+    }
+    const front::Module& m = c->module;
+    auto eval = interp::make_interpreter(ir::build_tape(m.graph, m.prints[0].nodes[0], 0), {});
+    ConstantValue v;
+    v.enclosure = eval->eval_box(nullptr);
+    v.point = eval->eval_point(nullptr);
+    if (v.enclosure.is_empty() || !std::isfinite(v.enclosure.lo) || !std::isfinite(v.enclosure.hi))
+        throw UsageError(fmt::format("{} '{}' is not a finite number", what, text));
+    return v;
+}
+
+void check_output_writable(const std::string& path) {
+    std::error_code ec;
+    const bool existed = std::filesystem::exists(path, ec);
+    {
+        std::ofstream probe(path, std::ios::binary | std::ios::app);
+        if (!probe) throw UsageError(fmt::format("cannot write '{}': {}", path, std::strerror(errno)));
+    }
+    if (!existed) std::filesystem::remove(path, ec);
+}
+
 std::vector<ir::Interval> parse_box(const std::string& text, int dimension) {
     const auto axes = split(text, ',');
     if (static_cast<int>(axes.size()) != dimension)
-        throw RunError(fmt::format("the box '{}' has {} axes, the shape has {} coordinates", text,
-                                   axes.size(), dimension));
+        throw UsageError(fmt::format("the box '{}' has {} axes; the shape takes {} ({})", text, axes.size(),
+                                     dimension, box_form(dimension)));
     std::vector<ir::Interval> box;
     for (const std::string& axis : axes) {
         const auto bounds = split(axis, ':');
-        if (bounds.size() != 2) throw RunError(fmt::format("'{}' is not an interval lo:hi", axis));
-        const ir::Interval lo = parse_number(bounds[0]), hi = parse_number(bounds[1]);
-        if (!(lo.lo <= hi.hi)) throw RunError(fmt::format("empty interval '{}'", axis));
+        if (bounds.size() != 2) throw UsageError(fmt::format("'{}' is not an interval lo:hi", axis));
+        const ir::Interval lo = evaluate_constant(bounds[0], "the bound").enclosure;
+        const ir::Interval hi = evaluate_constant(bounds[1], "the bound").enclosure;
+        if (!(lo.lo <= hi.hi)) throw UsageError(fmt::format("empty interval '{}': lo > hi", axis));
         box.push_back({lo.lo, hi.hi});
     }
     return box;
@@ -105,13 +180,14 @@ std::vector<double> parse_point(const std::string& text, int dimension,
                                 std::vector<ir::Interval>* enclosure) {
     const auto coords = split(text, ',');
     if (static_cast<int>(coords.size()) != dimension)
-        throw RunError(fmt::format("the point '{}' has {} coordinates, the shape has {}", text, coords.size(),
-                                   dimension));
+        throw UsageError(fmt::format("the point '{}' has {} coordinate{}; the shape takes {} ({})", text,
+                                     coords.size(), coords.size() == 1 ? "" : "s", dimension,
+                                     point_form(dimension)));
     std::vector<double> p;
     for (const std::string& c : coords) {
-        const ir::Interval v = parse_number(c);
-        if (enclosure) enclosure->push_back(v);
-        p.push_back(std::stod(c));
+        const ConstantValue v = evaluate_constant(c, "the coordinate");
+        if (enclosure) enclosure->push_back(v.enclosure);
+        p.push_back(v.point);
     }
     return p;
 }

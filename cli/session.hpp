@@ -18,14 +18,35 @@ struct EngineOptions {
     int threads = 0; // subdivision threads; 0: all cores
 };
 
-// A user-facing run-time failure (bad option value, unknown shape, I/O): message and exit code 1.
+// A user-facing run-time failure (I/O, a computation that cannot be done): message and exit code 1.
 struct RunError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+// A mistake on the command line (unknown shape, bad number, wrong output name): exit code 64.
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// The --set NAME=VALUE options of the command; every later compile_or_report applies them. Throws
+// UsageError when one is not NAME=VALUE or its value is not a constant expression.
+void set_constant_overrides(const std::vector<std::string>& sets);
+
 // Compiles `path`; on errors prints the diagnostics to stderr and returns null.
 std::unique_ptr<front::Compilation> compile_or_report(const std::string& path,
                                                       front::StopAfter stop = front::StopAfter::elaborate);
+
+// A constant expression given on the command line (`1/3`, `sqrt(2)/2`, `pi/4`), evaluated by the
+// language itself in an empty module: its proven enclosure and its point value. `what` names it in
+// the UsageError thrown when it is not a constant.
+struct ConstantValue {
+    ir::Interval enclosure;
+    double point = 0;
+};
+ConstantValue evaluate_constant(const std::string& text, const std::string& what);
+
+// Throws UsageError when `path` cannot be written (checked before any work; leaves no file behind).
+void check_output_writable(const std::string& path);
 
 const front::ShapeInfo& find_shape(const front::Compilation& c, const std::string& name);
 // The shape named, or the model's only/first shape when `name` is empty.

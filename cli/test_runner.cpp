@@ -16,16 +16,25 @@ struct ClosedEval {
 };
 
 // Evaluates a closed expression (one that reads only query answers) as an enclosure and a point value.
+// An expression that reads an enclosure (enclose(s, B)) has no point value: the midpoint of the
+// enclosure would pose as one, so `point` is left empty then.
 ir::Interval enclose_closed(const front::Module& m, ir::NodeId node, const EngineOptions& engine,
-                            std::vector<std::optional<ir::Interval>>& answers, double* point) {
+                            std::vector<std::optional<ir::Interval>>& answers, std::optional<double>* point) {
     const int inputs = static_cast<int>(m.queries.size());
     const ir::Tape tape = ir::build_tape(m.graph, node, inputs);
     std::vector<ir::Interval> in = answer_queries(m, tape, engine, answers);
     auto eval = make_evaluator(m, node, inputs, engine);
     if (point) {
-        std::vector<double> p;
-        for (const ir::Interval& v : in) p.push_back(num::midpoint(v));
-        *point = eval->eval_point(p.data());
+        bool reads_enclosure = false;
+        for (std::size_t k = 0; k < tape.input_slots.size(); ++k)
+            reads_enclosure |=
+                tape.input_slots[k] != ir::no_slot && m.queries[k].kind == front::Query::Kind::enclose;
+        point->reset();
+        if (!reads_enclosure) {
+            std::vector<double> p;
+            for (const ir::Interval& v : in) p.push_back(num::midpoint(v));
+            *point = eval->eval_point(p.data());
+        }
     }
     return eval->eval_box(in.data());
 }
@@ -37,10 +46,11 @@ std::string truth_text(ir::Interval t) {
     return "unknown";
 }
 
-std::string value_text(ir::Interval v, double point) {
+std::string value_text(ir::Interval v, std::optional<double> point) {
     if (v.is_thin()) return fmt::format("{}", v.lo);
     if (v.is_empty()) return "empty";
-    return fmt::format("{} in {}", point, format_interval(v));
+    if (!point) return format_interval(v);
+    return fmt::format("{} in {}", *point, format_interval(v));
 }
 
 void run_prints(const front::Compilation& c, const EngineOptions& engine,
@@ -62,7 +72,7 @@ void run_prints(const front::Compilation& c, const EngineOptions& engine,
         case front::ValueKind::point: {
             std::string s;
             for (std::size_t i = 0; i < p.nodes.size(); ++i) {
-                double pt = 0;
+                std::optional<double> pt;
                 const ir::Interval v = enclose_closed(m, p.nodes[i], engine, answers, &pt);
                 s += (i ? ", " : "") + value_text(v, pt);
             }
@@ -95,7 +105,7 @@ int run_tests(const std::vector<std::string>& files, bool prints, const EngineOp
                     if (truth == ir::tv_true) continue;
                     std::string shown;
                     for (ir::NodeId n : x.shown) {
-                        double pt = 0;
+                        std::optional<double> pt;
                         const ir::Interval v = enclose_closed(c->module, n, engine, answers, &pt);
                         shown += (shown.empty() ? "" : ", ") + value_text(v, pt);
                     }

@@ -72,6 +72,7 @@ struct Item {
     ItemKind kind;
     Location loc;
     std::string name;            // fn/const/shape name, test title, import path
+    std::string alias;           // import "m" as alias: the module's names are alias.name
     std::vector<Param> params;   // fn, shape
     bool has_params = false;     // shape with an explicit parameter list
     ExprPtr over;                // shape: default box, or null

@@ -34,6 +34,12 @@ const Builtin* find_builtin(const std::string& name) {
     return nullptr;
 }
 
+std::vector<std::string> builtin_names() {
+    std::vector<std::string> names;
+    for (const Builtin& b : builtins) names.push_back(b.name);
+    return names;
+}
+
 bool is_builtin_constant(const std::string& name) {
     return name == "pi" || name == "e";
 }

@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace frac::front {
 
@@ -27,5 +28,6 @@ struct Builtin {
 
 const Builtin* find_builtin(const std::string& name);
 bool is_builtin_constant(const std::string& name); // pi, e
+std::vector<std::string> builtin_names();          // the builtin functions, for suggestions
 
 } // namespace frac::front

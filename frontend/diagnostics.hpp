@@ -72,7 +72,8 @@ struct InternalError : std::logic_error {
     using std::logic_error::logic_error;
 };
 
-// Exit codes (BSD sysexits): a model that does not compile, a run-time failure, a bug.
+// Exit codes (BSD sysexits): a bad command line, a model that does not compile, a run-time failure, a bug.
+inline constexpr int exit_usage_error = 64;
 inline constexpr int exit_compile_error = 65;
 inline constexpr int exit_runtime_error = 1;
 inline constexpr int exit_internal_error = 70;

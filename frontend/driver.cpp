@@ -1,7 +1,9 @@
 #include "frontend/driver.hpp"
 
 #include "frontend/resolve.hpp"
+#include "frontend/suggest.hpp"
 
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -37,16 +39,92 @@ bool read_file(const std::string& path, std::string& text, std::string& why) {
     return true;
 }
 
+// Renames the definitions of a module imported `as alias` to alias.name, and the uses of them in the
+// module's own bodies (a parameter or a local of the same name is not a use).
+class Qualifier {
+public:
+    Qualifier(const std::string& alias, Program& module) : alias_(alias) {
+        for (const Item& it : module.items)
+            if (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape)
+                globals_.insert(it.name);
+    }
+
+    void rename(Item& it) {
+        if (globals_.count(it.name) &&
+            (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape))
+            it.name = qualified(it.name);
+        locals_.clear();
+        std::set<std::string> params;
+        for (const Param& p : it.params) params.insert(p.name);
+        if (it.kind == ItemKind::shape && !it.has_params) params = {"x", "y", "z"};
+        locals_.push_back(params);
+        if (it.over) expr(*it.over);
+        if (it.body) expr(*it.body);
+        for (Expect& e : it.expects) {
+            expr(*e.expr);
+            if (e.within) expr(*e.within);
+        }
+    }
+
+private:
+    std::string qualified(const std::string& name) const { return alias_ + "." + name; }
+    bool global(const std::string& name) const {
+        for (const auto& scope : locals_)
+            if (scope.count(name)) return false;
+        return globals_.count(name) > 0;
+    }
+    void expr(Expr& e) {
+        switch (e.kind) {
+        case ExprKind::name:
+        case ExprKind::call:
+            if (global(e.text)) e.text = qualified(e.text);
+            for (Arg& a : e.args) expr(*a.value);
+            return;
+        case ExprKind::let:
+            locals_.emplace_back();
+            for (Binding& b : e.bindings) {
+                expr(*b.value);
+                locals_.back().insert(b.name);
+            }
+            expr(*e.kids[0]);
+            locals_.pop_back();
+            return;
+        case ExprKind::lambda:
+            locals_.emplace_back();
+            for (const Binding& b : e.bindings) locals_.back().insert(b.name);
+            expr(*e.kids[0]);
+            locals_.pop_back();
+            return;
+        case ExprKind::series:
+            for (std::size_t k : {0u, 1u, 3u, 4u})
+                if (k < e.kids.size() && e.kids[k]) expr(*e.kids[k]);
+            if (!e.orbit_map.empty() && global(e.orbit_map)) e.orbit_map = qualified(e.orbit_map);
+            locals_.push_back({e.var, e.orbit_var});
+            expr(*e.kids[2]);
+            locals_.pop_back();
+            return;
+        default:
+            for (ExprPtr& k : e.kids)
+                if (k) expr(*k);
+            return;
+        }
+    }
+
+    std::string alias_;
+    std::set<std::string> globals_;
+    std::vector<std::set<std::string>> locals_;
+};
+
 class Loader {
 public:
-    Loader(Compilation& c) : c_(c) {}
+    Loader(Compilation& c, Program& into) : c_(c), into_(into) {}
 
     void load(const std::string& name, const std::string& text, const std::filesystem::path& dir) {
         const std::uint32_t file = c_.sources.add(name, text);
         Program p = parse(lex(text, file, c_.diags), c_.diags);
         for (Item& it : p.items) {
             if (it.kind == ItemKind::import) import(it, dir);
-            c_.program.items.push_back(std::move(it));
+            into_.items.push_back(std::move(it));
         }
     }
 
@@ -54,32 +132,74 @@ private:
     void import(const Item& it, const std::filesystem::path& dir) {
         const std::string& spec = it.name;
         const bool library = spec.find('/') == std::string::npos && spec.find(".frac") == std::string::npos;
+        std::string name, text, key;
+        std::filesystem::path module_dir = dir;
         if (library) {
             auto lib = embedded_stdlib().find(spec);
             if (lib == embedded_stdlib().end()) {
-                c_.diags.error(it.loc, fmt::format("no standard library module '{}'", spec));
+                std::vector<std::string> modules;
+                for (const auto& [m, t] : embedded_stdlib()) modules.push_back(m);
+                const auto near = closest_name(spec, modules);
+                c_.diags.error(it.loc, fmt::format("no standard library module '{}'{} (modules: {})", spec,
+                                                   near ? fmt::format("; did you mean \"{}\"?", *near) : "",
+                                                   list_names(modules)));
                 return;
             }
-            if (seen_.insert("std:" + spec).second)
-                load(fmt::format("<stdlib>/{}.frac", spec), lib->second, dir);
+            name = fmt::format("<stdlib>/{}.frac", spec);
+            text = lib->second;
+            key = "std:" + spec;
+        } else {
+            const std::filesystem::path path = (dir / spec).lexically_normal();
+            std::error_code ec;
+            const auto canonical = std::filesystem::weakly_canonical(path, ec);
+            key = ec ? path.string() : canonical.string();
+            if (seen_.count(key + " as " + it.alias)) return; // imported already (or a cycle)
+            std::string why;
+            if (!read_file(path.string(), text, why)) {
+                c_.diags.error(it.loc, fmt::format("cannot read '{}': {}", path.string(), why));
+                return;
+            }
+            name = path.string();
+            module_dir = path.parent_path();
+        }
+        if (!seen_.insert(key + " as " + it.alias).second) return; // imported already (or a cycle)
+        if (it.alias.empty()) {
+            load(name, text, module_dir);
             return;
         }
-        const std::filesystem::path path = (dir / spec).lexically_normal();
-        std::error_code ec;
-        const auto canonical = std::filesystem::weakly_canonical(path, ec);
-        if (!seen_.insert(ec ? path.string() : canonical.string()).second)
-            return; // imported already (or a cycle)
-        std::string text, why;
-        if (!read_file(path.string(), text, why)) {
-            c_.diags.error(it.loc, fmt::format("cannot read '{}': {}", path.string(), why));
-            return;
+        // A qualified module is loaded on its own (its imports too), then its names get the prefix: it
+        // shares nothing with the importing files but what they reach through the prefix.
+        Program module;
+        Loader(c_, module).load(name, text, module_dir);
+        Qualifier q(it.alias, module);
+        for (Item& m : module.items) {
+            q.rename(m);
+            into_.items.push_back(std::move(m));
         }
-        load(path.string(), text, path.parent_path());
     }
 
     Compilation& c_;
+    Program& into_;
     std::set<std::string> seen_;
 };
+
+// Replaces the body of every constant named by an override with the override's expression, parsed
+// as a file of its own so that its diagnostics point into the command line's text.
+void apply_overrides(Compilation& c, const ConstOverrides& overrides) {
+    for (const auto& [name, value] : overrides) {
+        bool found = false;
+        for (Item& it : c.program.items) {
+            if (it.kind != ItemKind::const_ || it.name != name) continue;
+            const std::string text = fmt::format("const {} = {};", name, value);
+            const std::uint32_t file = c.sources.add(fmt::format("<--set {}>", name), text);
+            Program p = parse(lex(text, file, c.diags), c.diags);
+            if (p.items.size() == 1 && p.items[0].kind == ItemKind::const_)
+                it.body = std::move(p.items[0].body);
+            found = true;
+        }
+        if (!found) c.unknown_overrides.push_back(name);
+    }
+}
 
 void finish(Compilation& c, const Limits& limits, StopAfter stop) {
     if (stop == StopAfter::parse || c.diags.has_errors()) return;
@@ -95,19 +215,29 @@ void finish(Compilation& c, const Limits& limits, StopAfter stop) {
 std::unique_ptr<Compilation> compile_source(const std::string& name, const std::string& text,
                                             const Limits& limits, StopAfter stop) {
     auto c = std::make_unique<Compilation>();
-    Loader(*c).load(name, text, std::filesystem::current_path());
+    Loader(*c, c->program).load(name, text, std::filesystem::current_path());
     finish(*c, limits, stop);
     return c;
 }
 
-std::unique_ptr<Compilation> compile_file(const std::string& path, const Limits& limits, StopAfter stop) {
+bool is_identifier(const std::string& text) {
+    if (text.empty() || !(std::isalpha(static_cast<unsigned char>(text[0])) || text[0] == '_')) return false;
+    for (char ch : text)
+        if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_')) return false;
+    return true;
+}
+
+std::unique_ptr<Compilation> compile_file(const std::string& path, const Limits& limits, StopAfter stop,
+                                          const ConstOverrides& overrides) {
     auto c = std::make_unique<Compilation>();
     std::string text, why;
     if (!read_file(path, text, why)) {
         c->diags.error({}, fmt::format("cannot read '{}': {}", path, why));
         return c;
     }
-    Loader(*c).load(path, text, std::filesystem::path(path).parent_path());
+    Loader(*c, c->program).load(path, text, std::filesystem::path(path).parent_path());
+    apply_overrides(*c, overrides);
+    if (!c->unknown_overrides.empty()) return c;
     finish(*c, limits, stop);
     return c;
 }

@@ -129,7 +129,7 @@ private:
         info.name = it.name;
         info.loc = it.loc;
         if (it.over) {
-            const Value box = closed(*it.over, Context::constant);
+            const Value box = closed(*it.over, Context::constant, true);
             if (box.kind != ValueKind::box)
                 fail(it.over->loc, fmt::format("'over' needs a box such as [0, 1] × [0, 1], found {}",
                                                kind_name(box.kind)));
@@ -242,7 +242,7 @@ private:
         int level = 0; // series nesting
     };
 
-    Value closed(const Expr& e, Context ctx) {
+    Value closed(const Expr& e, Context ctx, bool box_expected = false) {
         Frame f{ctx, {}, 0};
         frames_.push_back(std::move(f));
         frames_.back().scopes.emplace_back();
@@ -250,6 +250,25 @@ private:
             std::vector<Frame>& f;
             ~Pop() { f.pop_back(); }
         } pop{frames_};
+        return box_expected ? expected_box(e) : expr(e);
+    }
+
+    // Where a box is expected (`over`, enclose's box), `*` between intervals is the ASCII spelling of
+    // ×: a number is never a box, so there the product of intervals cannot be meant.
+    Value expected_box(const Expr& e) {
+        if (e.kind == ExprKind::binary && e.op == Tok::star) {
+            const Value a = expected_box(*e.kids[0]);
+            const Value b = expr(*e.kids[1]);
+            if ((a.kind == ValueKind::interval || a.kind == ValueKind::box) &&
+                b.kind == ValueKind::interval) {
+                Value r;
+                r.kind = ValueKind::box;
+                r.box = a.box;
+                r.box.push_back(b.box[0]);
+                if (r.box.size() > 3) fail(e.loc, "boxes have 2 or 3 axes");
+                return r;
+            }
+        }
         return expr(e);
     }
 
@@ -498,7 +517,7 @@ private:
         q.shape = shape_info(*s.shape);
         const ShapeInfo& info = m_.shapes[q.shape];
         if (b.kind == BuiltinKind::enclose) {
-            const Value box = expr(*e.args[1].value);
+            const Value box = expected_box(*e.args[1].value);
             if (box.kind != ValueKind::box)
                 fail(e.args[1].loc, fmt::format("'enclose' needs a box, found {}", kind_name(box.kind)));
             if (static_cast<int>(box.box.size()) != info.dimension)

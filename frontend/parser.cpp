@@ -2,6 +2,7 @@
 #include "frontend/ast.hpp"
 
 #include <fmt/format.h>
+#include <set>
 
 namespace frac::front {
 
@@ -41,7 +42,13 @@ private:
         return true;
     }
     const Token& expect(Tok k, const char* what) {
-        if (!at(k)) fail(fmt::format("expected {} {}, found {}", token_name(k), what, describe(cur())));
+        if (!at(k)) {
+            // `[0, 1] x [0, 1]`: x is a name (a coordinate), not the box product.
+            if (at(Tok::ident) && cur().text == "x" && pos_ > 0 && t_[pos_ - 1].kind == Tok::rbracket)
+                fail("'x' is a name, not the box product: write × or * between the intervals, as in "
+                     "[0, 1] × [0, 1]");
+            fail(fmt::format("expected {} {}, found {}", token_name(k), what, describe(cur())));
+        }
         return take();
     }
     static std::string describe(const Token& tok) {
@@ -80,6 +87,11 @@ private:
             take();
             it.kind = ItemKind::import;
             it.name = expect(Tok::string, "after 'import'").text;
+            if (at(Tok::ident) && cur().text == "as") {
+                take();
+                it.alias = expect(Tok::ident, "after 'as' (the module's prefix)").text;
+                aliases_.insert(it.alias);
+            }
             expect(Tok::semicolon, "after the import");
             return it;
         case Tok::kw_fn:
@@ -326,17 +338,23 @@ private:
         }
         case Tok::ident: {
             const Token& name = take();
+            std::string text = name.text;
+            // alias.name: a name of a module imported `as alias` (the alias shadows a point's fields).
+            if (aliases_.count(text) && at(Tok::dot) && ahead(1).kind == Tok::ident) {
+                take();
+                text += "." + take().text;
+            }
             if (!at(Tok::lparen)) {
                 auto e = make(ExprKind::name, name.loc);
-                e->text = name.text;
+                e->text = text;
                 return e;
             }
             take();
-            if ((name.text == "sum" || name.text == "min" || name.text == "max") && at(Tok::ident) &&
+            if ((text == "sum" || text == "min" || text == "max") && at(Tok::ident) &&
                 ahead(1).kind == Tok::kw_in)
                 return series(name);
             auto e = make(ExprKind::call, name.loc);
-            e->text = name.text;
+            e->text = text;
             if (!accept(Tok::rparen)) {
                 do {
                     Arg a;
@@ -410,6 +428,10 @@ private:
             ExprPtr init = expr();
             expect(Tok::comma, "after the orbit's initial point");
             e->orbit_map = expect(Tok::ident, "(the map of the orbit)").text;
+            if (aliases_.count(e->orbit_map) && at(Tok::dot) && ahead(1).kind == Tok::ident) {
+                take();
+                e->orbit_map += "." + take().text;
+            }
             expect(Tok::rparen, "to close the orbit");
             // An escape certificate: `escape R`, a radius the compiler proves orbits never return from.
             ExprPtr escape;
@@ -429,6 +451,7 @@ private:
     }
 
     static constexpr int max_nesting = 200;
+    std::set<std::string> aliases_; // of this file's qualified imports so far
     const std::vector<Token>& t_;
     Diagnostics& diags_;
     std::size_t pos_ = 0;

@@ -1,10 +1,14 @@
 #include "frontend/resolve.hpp"
 
 #include "frontend/builtins.hpp"
+#include "frontend/driver.hpp"
+#include "frontend/suggest.hpp"
 
 #include <algorithm>
 #include <fmt/format.h>
+#include <map>
 #include <optional>
+#include <set>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -182,7 +186,7 @@ private:
                 if (globals_.count(e.text) == 0 && find_builtin(e.text))
                     d_.error(e.loc, fmt::format("'{}' is a function; call it with arguments", e.text));
                 else
-                    d_.error(e.loc, fmt::format("unknown name '{}'", e.text));
+                    unknown(e.loc, "name", e.text);
             }
             return;
         case ExprKind::call: call(e); return;
@@ -291,7 +295,7 @@ private:
         }
         const Builtin* b = find_builtin(e.text);
         if (!b) {
-            d_.error(e.loc, fmt::format("unknown function '{}'", e.text));
+            unknown(e.loc, "function", e.text);
             return;
         }
         if (n < b->min_args || n > b->max_args) {
@@ -377,7 +381,55 @@ private:
         if (is_builtin_constant(v.text))
             d_.error(v.loc, fmt::format("{}, but '{}' is a constant", expected, v.text));
         else
-            d_.error(v.loc, fmt::format("unknown name '{}'", v.text));
+            unknown(v.loc, "name", v.text);
+    }
+
+    // An unknown name: the closest known one when it is a likely misspelling, and the standard library
+    // module that defines the name when the model does not import it.
+    void unknown(Location loc, const char* what, const std::string& name) {
+        std::vector<std::string> known;
+        for (const auto& scope : scopes_)
+            for (const auto& [local_name, kind] : scope) known.push_back(local_name);
+        for (const auto& [global, item] : globals_) known.push_back(global);
+        std::sort(known.begin() + static_cast<std::ptrdiff_t>(known.size() - globals_.size()), known.end());
+        for (const char* c : {"pi", "e"}) known.push_back(c);
+        for (const std::string& b : builtin_names()) known.push_back(b);
+        std::optional<std::string> near = closest_name(name, known);
+        for (const auto& [global, item] : globals_) // a name of a module imported `as alias`
+            if (!near && global.size() > name.size() && global.ends_with("." + name)) near = global;
+        // Else a library name, misspelt or not: the note then says which module to import.
+        std::string library_name = name;
+        if (!near)
+            for (const auto& [module, names] : stdlib_names())
+                if (auto n = closest_name(name, {names.begin(), names.end()}); n && !names.count(name)) {
+                    near = library_name = *n;
+                    break;
+                }
+        d_.error(loc, fmt::format("unknown {} '{}'{}", what, name,
+                                  near ? fmt::format("; did you mean '{}'?", *near) : ""));
+        for (const auto& [module, names] : stdlib_names())
+            if (names.count(library_name)) {
+                d_.note(loc, fmt::format("'{}' is defined in the standard library module \"{}\": add "
+                                         "import \"{}\"; at the top of the file",
+                                         library_name, module, module));
+                break;
+            }
+    }
+
+    // The names each standard library module defines, from its own parse.
+    static const std::map<std::string, std::set<std::string>>& stdlib_names() {
+        static const std::map<std::string, std::set<std::string>> names = [] {
+            std::map<std::string, std::set<std::string>> all;
+            for (const auto& [module, text] : embedded_stdlib()) {
+                Diagnostics ignored; // the library compiles; its tests say so
+                const Program p = parse(lex(text, 1, ignored), ignored);
+                for (const Item& it : p.items)
+                    if (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape)
+                        all[module].insert(it.name);
+            }
+            return all;
+        }();
+        return names;
     }
 
     const Program& p_;

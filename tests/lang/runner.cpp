@@ -1,7 +1,10 @@
 // Golden-test runner for tests/lang: a .frac file states how to run it and what must come out.
 //   // args: render --depth 3 --ascii 8x4   the frac subcommand and options (default: run); FILE goes
-//                                           right after the subcommand
-//   // expect: TEXT                         the next line of stdout (all of stdout must be expected)
+//                                           right after the subcommand, or where $FILE stands
+//                                           (// args: help eval --set a=$FILE), not at all with
+//                                           $NOFILE (// args: help eval $NOFILE)
+//   // expect: TEXT                         the next line of stdout (all of stdout must be expected);
+//                                           TEXT ending in "..." matches a line that begins with it
 //   // expect error: LINE:COL: MESSAGE      a diagnostic "FILE:LINE:COL: error: MESSAGE" on stderr
 //                                           (every error on stderr must be expected)
 //   // expect stderr: TEXT                  some line of stderr contains TEXT
@@ -81,10 +84,18 @@ int main(int argc, char** argv) {
     if (fo < 0 || fe < 0) return 2;
     close(fo);
     close(fe);
-    const std::string sub = args.substr(0, args.find(' '));
-    const std::string rest = args.find(' ') == std::string::npos ? "" : args.substr(args.find(' '));
-    const std::string cmd = quote(frac) + " " + sub + " " + quote(file) + rest + " >" + out_path + " 2>" +
-                            err_path + " </dev/null";
+    std::string command_line;
+    if (const auto at = args.find("$NOFILE"); at != std::string::npos) {
+        command_line = args.substr(0, at) + args.substr(at + 7);
+    } else if (const auto at = args.find("$FILE"); at != std::string::npos) {
+        command_line = args.substr(0, at) + quote(file) + args.substr(at + 5);
+    } else {
+        const std::string sub = args.substr(0, args.find(' '));
+        const std::string rest = args.find(' ') == std::string::npos ? "" : args.substr(args.find(' '));
+        command_line = sub + " " + quote(file) + rest;
+    }
+    const std::string cmd =
+        quote(frac) + " " + command_line + " >" + out_path + " 2>" + err_path + " </dev/null";
     const int status = std::system(cmd.c_str());
     const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     const auto out = lines(read(out_path)), err = lines(read(err_path));
@@ -101,7 +112,8 @@ int main(int argc, char** argv) {
     for (std::size_t i = 0; i < std::max(out.size(), want_out.size()); ++i) {
         const std::string got = i < out.size() ? out[i] : "<nothing>";
         const std::string want = i < want_out.size() ? want_out[i] : "<nothing>";
-        if (got != want)
+        const bool prefix = want.size() >= 3 && want.compare(want.size() - 3, 3, "...") == 0;
+        if (prefix ? got.rfind(want.substr(0, want.size() - 3), 0) != 0 : got != want)
             fail("stdout line " + std::to_string(i + 1) + ": got '" + got + "', expected '" + want + "'");
     }
     std::size_t error_lines = 0;
