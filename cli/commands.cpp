@@ -8,8 +8,10 @@
 #include "runtime/relief.hpp"
 #include "runtime/rss.hpp"
 #include "runtime/slice.hpp"
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <memory>
 
 #include <algorithm>
 #include <cmath>
@@ -105,10 +107,17 @@ int run_eval(const std::string& file, const std::string& shape, const std::strin
 
 namespace {
 
-rt::RssProgress terminal_progress() {
+rt::RssProgress terminal_progress(std::shared_ptr<bool> printed) {
     if (!isatty(STDERR_FILENO)) return {};
-    return [](int level, std::uint64_t evaluated) {
-        std::cerr << fmt::format("\rlevel {:2}: {} boxes evaluated", level, evaluated) << std::flush;
+    // Quiet for the first second: short runs print nothing but their summary.
+    const auto start = std::chrono::steady_clock::now();
+    return [start, printed](int level, std::uint64_t evaluated) {
+        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (s < 1.0) return;
+        *printed = true;
+        std::cerr << fmt::format("\rlevel {:2}: {} boxes evaluated, {:.3g} million a second", level,
+                                 evaluated, static_cast<double>(evaluated) / s / 1e6)
+                  << std::flush;
     };
 }
 
@@ -120,10 +129,11 @@ rt::RssResult cover(const std::vector<ir::Interval>& box, int depth, int split, 
     ro.depth = depth;
     ro.split = split;
     ro.keep_cells = keep_cells;
-    ro.progress = terminal_progress();
+    auto printed = std::make_shared<bool>(false);
+    ro.progress = terminal_progress(printed);
     try {
         rt::RssResult r = rt::subdivide(eval, box, ro);
-        if (ro.progress) std::cerr << "\n";
+        if (*printed) std::cerr << "\n"; // end the progress line
         return r;
     } catch (const std::invalid_argument& e) {
         throw RunError(e.what());
