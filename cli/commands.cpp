@@ -3,6 +3,7 @@
 
 #include "backend/llvm/jit.hpp"
 #include "runtime/dimension.hpp"
+#include "runtime/legend.hpp"
 #include "runtime/mesh.hpp"
 #include "runtime/picture.hpp"
 #include "runtime/relief.hpp"
@@ -226,7 +227,7 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
     if (!o.output.empty()) {
         try {
             if (ends_with(o.output, ".png")) {
-                rt::write_png(r, o.output, kind, o.size);
+                rt::write_png(rt::with_legend(rt::render(r, kind, o.size), kind), o.output);
             } else {
                 // About 48 bytes a rectangle (measured): the cover's inside and boundary leaves, the
                 // process's cells.
