@@ -56,7 +56,7 @@ public:
     bool reads_state(NodeId id) {
         if (auto it = state_memo_.find(id); it != state_memo_.end()) return it->second;
         const ir::Node& n = g_[id];
-        bool r = n.op == Op::State && n.imm / 8 == level_;
+        bool r = n.op == Op::State && ir::state_level(n.imm) == level_;
         if (ir::is_series(n.op)) r = true; // an inner series may read the point; never linear here
         for (NodeId a : n.args)
             if (a != no_node && reads_state(a)) r = true;
@@ -76,7 +76,7 @@ public:
     }
     int state_component(NodeId id) const {
         const ir::Node& n = g_[id];
-        return n.op == Op::State && n.imm / 8 == level_ ? static_cast<int>(n.imm % 8) : -1;
+        return n.op == Op::State && ir::state_level(n.imm) == level_ ? ir::state_component(n.imm) : -1;
     }
 
     // An enclosure of a node over all orbit points, indices and coordinates.

@@ -89,7 +89,7 @@ NodeId Graph::intern(const Node& n) {
     for (NodeId a : n.point_tail)
         if (a != no_node) stored.index_mask |= nodes_[a].index_mask;
     if (n.op == Op::Index) stored.index_mask = std::uint64_t{1} << n.imm;
-    if (n.op == Op::State) stored.index_mask = std::uint64_t{1} << (n.imm / 8);
+    if (n.op == Op::State) stored.index_mask = std::uint64_t{1} << state_level(n.imm);
     if (is_series(n.op)) stored.index_mask &= ~(std::uint64_t{1} << n.series.level);
     const auto id = static_cast<NodeId>(nodes_.size());
     nodes_.push_back(stored);
@@ -125,7 +125,7 @@ NodeId Graph::state(int level, int component) {
         throw std::invalid_argument("orbit state out of range");
     Node n;
     n.op = Op::State;
-    n.imm = level * 8 + component;
+    n.imm = state_imm(level, component);
     return intern(n);
 }
 

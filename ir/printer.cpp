@@ -41,7 +41,7 @@ std::string print_graph(const Graph& g, const std::vector<NodeId>& roots) {
                 out += n.value.is_thin() ? fmt::format(" {}", n.value.lo)
                                          : fmt::format(" [{}, {}] ~{}", n.value.lo, n.value.hi, n.point);
             else if (n.op == Op::State)
-                out += fmt::format(" {}.{}", n.imm / 8, n.imm % 8);
+                out += fmt::format(" {}.{}", state_level(n.imm), state_component(n.imm));
             else
                 out += fmt::format(" {}", n.imm);
             break;

@@ -92,7 +92,7 @@ double escape_bound(Op kind, const OrbitEscape& e, const Interval* state, int di
 
 bool escape_stalls(Op kind, double now, double prev, Interval acc) {
     // "Worse" beyond rounding noise: by more than 2^-30 of the previous bound (upward rounding).
-    const double slack = 0x1p-30 * std::fabs(prev);
+    const double slack = escape_stall_slack * std::fabs(prev);
     if (kind == Op::SeriesMax) return now < inf && (now <= acc.hi || now > prev + slack);
     return now > -inf && (now >= acc.lo || now < prev - slack);
 }
@@ -148,7 +148,7 @@ bool escape_point_done(Op kind, const OrbitEscape& e, double acc, const double* 
     if (!(norm > e.radius)) return false;
     const double bound = (e.slope * (norm - e.radius) + e.offset) *
                          (e.scale0.lo / std::pow(e.growth.lo, static_cast<double>(n)));
-    const double slack = 0x1p-54 * std::fabs(acc);
+    const double slack = point_stop_ratio * std::fabs(acc);
     return kind == Op::SeriesMax ? -bound <= acc + slack : bound >= acc - slack;
 }
 

@@ -9,6 +9,18 @@
 
 namespace frac::ir {
 
+// The stopping rules' constants, for every engine (interpreter, JIT point and box code):
+//  - a box series stops when a term is no narrower than `term_resolution` of its static bound (the box
+//    is too wide for later terms to resolve anything);
+//  - a box series stops when the tail's width is below `box_stop_ratio` of the partial result;
+//  - a point series stops when a bound of the tail is below `point_stop_ratio` of the partial result
+//    (a quarter of an ulp: later terms cannot change the rounded sum);
+//  - an escape bound that gets worse by more than `escape_stall_slack` of the previous one stalls.
+inline constexpr double term_resolution = 0.75;
+inline constexpr double box_stop_ratio = 0x1p-52;
+inline constexpr double point_stop_ratio = 0x1p-54;
+inline constexpr double escape_stall_slack = 0x1p-30;
+
 // Enclosure of the tail: for a sum, of sum_{i>n} t_i; for a min (max), of inf (sup) over i>n of t_i,
 // which is <= 0 (>= 0) because the terms tend to 0. `has_b` is false when B is absent (zero).
 Interval series_tail(Op kind, Interval a, Interval b, bool has_b, Interval gamma, std::int64_t n);

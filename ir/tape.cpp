@@ -96,7 +96,7 @@ private:
         const auto states = static_cast<std::size_t>(n.series.state_count);
         for (std::size_t c = 0; c < states; ++c) {
             s.state_slots.push_back(fresh());
-            contexts_.back().memo[find_leaf(Op::State, n.series.level * 8 + static_cast<std::int64_t>(c))] =
+            contexts_.back().memo[find_leaf(Op::State, state_imm(n.series.level, static_cast<int>(c)))] =
                 s.state_slots.back();
         }
         s.body_slot = emit(n.args[0]);

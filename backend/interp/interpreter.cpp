@@ -172,7 +172,7 @@ private:
                 // Stop when this term told little more than its static bound: the box is too wide
                 // for later terms to resolve anything. (The factor absorbs the rounding of gamma^i.)
                 const Interval bound = ir::series_term_bound(a, b, has_b, gamma_i, i);
-                if (options_.adaptive_terms && num::width(term) >= 0.75 * num::width(bound)) {
+                if (options_.adaptive_terms && num::width(term) >= ir::term_resolution * num::width(bound)) {
                     resolved = true;
                     break;
                 }
@@ -184,7 +184,7 @@ private:
                     escape_now = ir::escape_bound(s.kind, s.data.escape, state, dims, i + 1);
                     tail = ir::escape_tighten(s.kind, tail, escape_now);
                 }
-                if (num::width(tail) <= 0x1p-52 * num::magnitude(acc) || num::width(tail) == 0) {
+                if (num::width(tail) <= ir::box_stop_ratio * num::magnitude(acc) || num::width(tail) == 0) {
                     resolved = true;
                     break;
                 }
@@ -269,7 +269,7 @@ private:
                 // A bound of the tail's size: stop once it is below half an ulp of the sum.
                 const double n1 = static_cast<double>(i + 1);
                 const double tail = (a + b * n1) * gamma_next * (n1 + 1.0) / ((1.0 - gamma) * (1.0 - gamma));
-                if (tail <= 0x1p-54 * std::fabs(acc) || tail == 0.0) {
+                if (tail <= ir::point_stop_ratio * std::fabs(acc) || tail == 0.0) {
                     resolved = true;
                     break;
                 }

@@ -15,6 +15,7 @@
 
 #include "backend/llvm/helpers.hpp"
 #include "ir/graph.hpp"
+#include "ir/series_tail.hpp"
 
 #include <llvm/IR/ConstantFold.h>
 #include <llvm/IR/Constants.h>
@@ -994,7 +995,7 @@ private:
             BasicBlock* check = BasicBlock::Create(ctx_, "series.check", fn_);
             b_.CreateCondBr(is_last, exit, check);
             b_.SetInsertPoint(check);
-            // 1. The term told little more than its static bound (0.75: the interpreter's factor).
+            // 1. The term told little more than its static bound (ir::term_resolution).
             Value* stop1 = i1(false);
             if (o_.adaptive_terms) {
                 Value* threshold;
@@ -1006,7 +1007,7 @@ private:
                                                     facts_of(st.gamma_n.data(), st.gamma_n.size()));
                     SlotState coeff = a;
                     if (has_b) coeff = op_add(a, op_mul(bc, states_[s.index_slot]));
-                    threshold = mul(cst(0.75), width(op_mul(coeff, gi)));
+                    threshold = mul(cst(ir::term_resolution), width(op_mul(coeff, gi)));
                 }
                 stop1 = land(active, ge(width(term), threshold));
             }
@@ -1033,8 +1034,8 @@ private:
                 tail = escape_tighten(s.kind, tail, esc_now);
                 tail_width = width(tail);
             }
-            Value* small =
-                b_.CreateOr(le(tail_width, mul(cst(0x1p-52), magnitude(nacc))), eq(tail_width, cst(0.0)));
+            Value* small = b_.CreateOr(le(tail_width, mul(cst(ir::box_stop_ratio), magnitude(nacc))),
+                                       eq(tail_width, cst(0.0)));
             if (s.kind == Op::SeriesMin) {
                 Value* one_sided = eq(fabs(tail.v.hi), cst(inf));
                 Value* no_gain = land(ge(tail.v.lo, nacc.v.lo), ge(term.v.hi, nacc.v.hi));
@@ -1046,7 +1047,7 @@ private:
             }
             if (escape) {
                 // ir::escape_stalls
-                Value* slack = mul(cst(0x1p-30), fabs(esc_prev));
+                Value* slack = mul(cst(ir::escape_stall_slack), fabs(esc_prev));
                 Value* stalls = s.kind == Op::SeriesMax
                                     ? land(lt(esc_now, cst(inf)),
                                            lor(le(esc_now, nacc.v.hi), gt(esc_now, add(esc_prev, slack))))

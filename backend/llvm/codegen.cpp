@@ -4,6 +4,7 @@
 
 #include "backend/llvm/box_codegen.hpp"
 #include "ir/graph.hpp"
+#include "ir/series_tail.hpp"
 
 #include <llvm/IR/Constants.h>
 #include <llvm/IR/DerivedTypes.h>
@@ -331,9 +332,10 @@ private:
             tail = b_.CreateFMul(tail, gnext);
             tail = b_.CreateFMul(tail, b_.CreateFAdd(n1, cst(1.0)));
             tail = b_.CreateFDiv(tail, cst(st.point_denominator));
-            Value* small = b_.CreateOr(
-                b_.CreateFCmpOLE(tail, b_.CreateFMul(cst(0x1p-54), intrinsic(llvm::Intrinsic::fabs, nacc))),
-                b_.CreateFCmpOEQ(tail, cst(0.0)));
+            Value* small =
+                b_.CreateOr(b_.CreateFCmpOLE(tail, b_.CreateFMul(cst(ir::point_stop_ratio),
+                                                                 intrinsic(llvm::Intrinsic::fabs, nacc))),
+                            b_.CreateFCmpOEQ(tail, cst(0.0)));
             gnext2 = b_.CreateFMul(gnext, cst(gamma));
             b_.CreateCondBr(small, exit, latch);
         }

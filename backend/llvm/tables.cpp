@@ -79,7 +79,7 @@ void series_tables(const Tape& t, const TapeSeries& s, const ir::EvalOptions& o,
         for (std::size_t k = 0; k < n_entries; ++k) {
             const std::int64_t i = out.first + static_cast<std::int64_t>(k);
             const Interval bound = ir::series_term_bound(a, b, has_b, gamma_i, i);
-            out.threshold[k] = 0.75 * num::width(bound);
+            out.threshold[k] = ir::term_resolution * num::width(bound);
             out.tail[k] = ir::series_tail(s.kind, a, b, has_b, gamma, i);
             out.tail_width[k] = num::width(out.tail[k]);
             gamma_i = num::mul(gamma_i, gamma);

@@ -8,7 +8,8 @@
 //    values, one entry per index the series can reach.
 //  - Series tables (infinite series): gamma^i as the interpreter accumulates it, gamma^(n+1) and the
 //    two geometric sums of ir::series_tail for every n. When the tail coefficients A and B are
-//    constants, the whole stopping test is tabulated: 0.75 * width(term bound) and the tail itself.
+//    constants, the whole stopping test is tabulated: ir::term_resolution * width(term bound) and the tail
+//    itself.
 #pragma once
 
 #include "ir/evaluator.hpp"
@@ -48,7 +49,7 @@ struct SeriesTables {
     bool const_tail = false;          // A (and B) are constants
     // const_tail: the stopping test and the tail after each index n (entry n - first), from
     // ir::series_term_bound and ir::series_tail themselves.
-    std::vector<double> threshold;  // 0.75 * width(series_term_bound(A, B, gamma_n, n))
+    std::vector<double> threshold;  // term_resolution * width(series_term_bound(A, B, gamma_n, n))
     std::vector<Interval> tail;     // series_tail(kind, A, B, gamma, n)
     std::vector<double> tail_width; // width(tail)
     // Otherwise: gamma^n as the interpreter accumulates it (powi(gamma, start), then * gamma), for the
