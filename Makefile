@@ -26,7 +26,7 @@ bench: build
 	cmake --build $(BUILD) -j $(JOBS) --target bench_all
 
 format:
-	find frontend ir backend runtime cli tests bench -name '*.cpp' -o -name '*.hpp' | xargs clang-format -i
+	find numeric frontend ir backend runtime cli tests bench -name '*.cpp' -o -name '*.hpp' | xargs clang-format -i
 
 clean:
 	rm -rf $(BUILD)
