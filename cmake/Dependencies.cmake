@@ -8,7 +8,9 @@ find_package(TBB REQUIRED) # parallel subdivision
 
 # LLVM's libc: correctly rounded exp/log/sin/cos/tan that honour the current rounding mode.
 find_library(LLVMLIBC_ARCHIVE llvmlibc PATHS /usr/lib/llvm-19/lib NO_DEFAULT_PATH REQUIRED)
-# MPFR/MPFI: high-precision oracle for the soundness tests only.
+# GMP (gmpxx): exact rationals in the numeric layer; MPFR: their directed rounding to doubles.
+# MPFI: high-precision oracle for the soundness tests only.
 find_library(MPFR_LIBRARY mpfr REQUIRED)
 find_library(MPFI_LIBRARY mpfi REQUIRED)
 find_library(GMP_LIBRARY gmp REQUIRED)
+find_library(GMPXX_LIBRARY gmpxx REQUIRED)

@@ -2,7 +2,7 @@
 // only through it, so every algorithm runs with every engine.
 #pragma once
 
-#include "runtime/numeric/interval.hpp"
+#include "numeric/interval.hpp"
 
 #include <cstddef>
 #include <cstdint>

@@ -2,7 +2,7 @@
 // always smaller than its user's). Functions and lets are inlined by the frontend before they get here.
 #pragma once
 
-#include "runtime/numeric/interval.hpp"
+#include "numeric/interval.hpp"
 
 #include <array>
 #include <cstdint>

@@ -4,7 +4,7 @@
 // dimensions and meshes take a Cover, whatever made it.
 #pragma once
 
-#include "runtime/numeric/interval.hpp"
+#include "numeric/interval.hpp"
 
 #include <cstdint>
 #include <vector>

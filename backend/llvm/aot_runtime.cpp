@@ -1,6 +1,6 @@
 #include "backend/llvm/aot_runtime.hpp"
 
-#include "runtime/numeric/interval.hpp"
+#include "numeric/interval.hpp"
 
 #include <cfenv>
 #include <cstring>

@@ -1,6 +1,6 @@
 // The interval evaluator: W boxes at a time (one per vector lane; W = 1 is plain scalar code).
 //
-// Every operation mirrors runtime/numeric/interval.cpp step by step: the same IEEE operations on the
+// Every operation mirrors numeric/interval.cpp step by step: the same IEEE operations on the
 // same operands, the same comparisons deciding between equal values of different sign, so the bits
 // are the interpreter's. Upward rounding comes either from LLVM's constrained intrinsics
 // ("round.upward", "fpexcept.ignore"; the caller holds MXCSR upward) or, on AVX-512 hosts, from
@@ -442,7 +442,7 @@ private:
         return result(call_scalar(name, flat), maybe_empty);
     }
 
-    // ---- interval operations: runtime/numeric/interval.cpp, step by step ----
+    // ---- interval operations: numeric/interval.cpp, step by step ----
     SlotState op_add(const SlotState& a, const SlotState& b) {
         Value* e = lor(empty_of(a), empty_of(b));
         return result(guard(e, widen_nan(add_down(a.v.lo, b.v.lo), add(a.v.hi, b.v.hi)), empty()),

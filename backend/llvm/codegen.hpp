@@ -6,7 +6,7 @@
 //     The caller holds upward rounding and passes only boxes without empty coordinates.
 //   void <name>_point(const double* coords, i64 n, double* out, u64* stats)   (round to nearest)
 //
-// Interval code mirrors runtime/numeric/interval.cpp operation for operation (the same IEEE
+// Interval code mirrors numeric/interval.cpp operation for operation (the same IEEE
 // operations in the same order, the same comparisons deciding ties of signed zeros), rounded upward
 // by constrained intrinsics or AVX-512 embedded rounding, so that no pass may fold, reorder or merge
 // a floating-point operation under the assumption of round-to-nearest. Lower bounds are computed as

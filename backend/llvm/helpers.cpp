@@ -3,7 +3,7 @@
 #include "ir/graph.hpp"
 #include "ir/semantics.hpp"
 #include "ir/series_tail.hpp"
-#include "runtime/numeric/interval.hpp"
+#include "numeric/interval.hpp"
 
 #include <cmath>
 

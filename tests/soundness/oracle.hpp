@@ -7,7 +7,7 @@
 // the box. Reused by the tests of the numeric core, the IR interpreter and the JIT.
 #pragma once
 
-#include "runtime/numeric/interval.hpp"
+#include "numeric/interval.hpp"
 
 #include <array>
 #include <cstdint>

@@ -1,7 +1,7 @@
 // Shared helpers for the numeric-core unit tests.
 #pragma once
 
-#include "runtime/numeric/interval.hpp"
+#include "numeric/interval.hpp"
 
 #include <catch2/catch.hpp>
 

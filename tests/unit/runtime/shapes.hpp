@@ -3,7 +3,7 @@
 #pragma once
 
 #include "ir/evaluator.hpp"
-#include "runtime/numeric/interval.hpp"
+#include "numeric/interval.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -8,7 +8,7 @@
 #pragma once
 
 #ifndef FRAC_LLVMLIBC_NAMESPACE
-#error "FRAC_LLVMLIBC_NAMESPACE must name LLVM libc's namespace (set by runtime/numeric/CMakeLists.txt)"
+#error "FRAC_LLVMLIBC_NAMESPACE must name LLVM libc's namespace (set by numeric/CMakeLists.txt)"
 #endif
 
 namespace FRAC_LLVMLIBC_NAMESPACE {

@@ -4,9 +4,9 @@
 // expression (rounded up); a lower bound is RD(f) = -RU(-f), computed by the *_down helpers. This file
 // is compiled with -frounding-math, and `opaque` additionally hides the negated operands from the
 // optimiser, so it cannot turn -((-x) - y) back into x + y.
-#include "runtime/numeric/interval.hpp"
+#include "numeric/interval.hpp"
 
-#include "runtime/numeric/llvm_libc.hpp"
+#include "numeric/llvm_libc.hpp"
 
 #include <algorithm>
 #include <bit>
