@@ -84,7 +84,10 @@ int run_eval(const std::string& file, const std::string& shape, const std::strin
         const std::vector<double> p = parse_point(at, s.dimension, &enclosure);
         const double value = eval->eval_point(p.data());
         const ir::Interval proven = eval->eval_box(enclosure.data());
-        std::cout << fmt::format("{} = {}\nenclosure {}\n", s.name, value, format_interval(proven));
+        // NaN prints as "nan" whatever its sign bit.
+        std::cout << fmt::format("{} = {}\nenclosure {}\n", s.name,
+                                 std::isnan(value) ? std::string("nan") : fmt::format("{}", value),
+                                 format_interval(proven));
         // NaN or an empty enclosure: the function is undefined there (sqrt or log of a negative number...),
         // which a caller testing the sign of the value must not miss.
         if (std::isnan(value) || proven.is_empty()) {
