@@ -9,6 +9,10 @@
 //                                           (every error on stderr must be expected)
 //   // expect stderr: TEXT                  some line of stderr contains TEXT
 //   // expect exit: N                       exit status (default 0, or 65 with expected errors)
+// Run as `lang_runner FRAC FILE ENGINE`, a command that evaluates (eval, render, mesh, dimension, test,
+// run) gets `--engine ENGINE`, unless its args name one; output files under /tmp/frac-lang- then get
+// the engine in their name, so that the runs under each engine can go on at once. CMake registers a file
+// once per engine (both by default; `// engines: interp` limits it), and once for other commands.
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -51,11 +55,11 @@ std::string quote(const std::string& s) {
 } // namespace
 
 int main(int argc, char** argv) {
-    if (argc != 3) {
-        std::cerr << "usage: lang_runner FRAC FILE.frac\n";
+    if (argc != 3 && argc != 4) {
+        std::cerr << "usage: lang_runner FRAC FILE.frac [ENGINE]\n";
         return 2;
     }
-    const std::string frac = argv[1], file = argv[2];
+    const std::string frac = argv[1], file = argv[2], engine = argc == 4 ? argv[3] : "";
     std::string args = "run";
     std::vector<std::string> want_out, want_errors, want_stderr;
     int want_exit = -1;
@@ -93,6 +97,17 @@ int main(int argc, char** argv) {
         const std::string sub = args.substr(0, args.find(' '));
         const std::string rest = args.find(' ') == std::string::npos ? "" : args.substr(args.find(' '));
         command_line = sub + " " + quote(file) + rest;
+    }
+    if (!engine.empty() && command_line.find("--engine") == std::string::npos) {
+        command_line += " --engine " + engine;
+        // The engine's own output files, named so in the expectations too.
+        auto rename = [&](std::string& text) {
+            for (std::size_t at = 0; (at = text.find("/tmp/frac-lang-", at)) != std::string::npos; at += 15)
+                text.insert(at + 15, engine + "-");
+        };
+        rename(command_line);
+        for (auto* list : {&want_out, &want_stderr})
+            for (std::string& w : *list) rename(w);
     }
     const std::string cmd =
         quote(frac) + " " + command_line + " >" + out_path + " 2>" + err_path + " </dev/null";
