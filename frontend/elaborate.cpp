@@ -3,6 +3,7 @@
 #include "frontend/builtins.hpp"
 #include "frontend/orbit_escape.hpp"
 #include "frontend/series_bounds.hpp"
+#include "numeric/rational.hpp"
 
 #include <cmath>
 #include <fmt/format.h>
@@ -401,6 +402,9 @@ private:
         const Interval v = num::from_decimal(e.text);
         if (!std::isfinite(v.lo) || !std::isfinite(v.hi))
             fail(e.loc, fmt::format("number '{}' is too large", e.text));
+        // A literal keeps its exact value as written (0.1 is 1/10), for exact folding and solving.
+        if (const std::optional<num::Rational> exact = num::Rational::parse_decimal(e.text))
+            return Value::scalar(g_.constant(*exact));
         return Value::scalar(g_.constant(v, std::strtod(e.text.c_str(), nullptr)));
     }
 

@@ -2,27 +2,17 @@
 
 #include "ir/point_bounds.hpp"
 #include "ir/semantics.hpp"
+#include "numeric/rational.hpp"
 
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 
 namespace frac::ir {
 
 namespace {
-
-struct OpInfo {
-    int arity;
-    const char* name;
-    OpClass cls;
-};
-
-constexpr OpInfo op_table[] = {
-#define FRAC_OP(name, arity, text, cls) {arity, text, OpClass::cls},
-#include "ir/opcodes.def"
-#undef FRAC_OP
-};
 
 std::uint64_t bits(double v) {
     return std::bit_cast<std::uint64_t>(v);
@@ -42,16 +32,6 @@ void mix(std::size_t& h, std::uint64_t v) {
 
 } // namespace
 
-int arity(Op op) {
-    return op_table[static_cast<int>(op)].arity;
-}
-const char* op_name(Op op) {
-    return op_table[static_cast<int>(op)].name;
-}
-OpClass op_class(Op op) {
-    return op_table[static_cast<int>(op)].cls;
-}
-
 std::size_t Graph::KeyHash::operator()(const Node& n) const {
     std::size_t h = static_cast<std::size_t>(n.op);
     for (NodeId a : n.args) mix(h, a);
@@ -64,6 +44,7 @@ std::size_t Graph::KeyHash::operator()(const Node& n) const {
     mix(h, static_cast<std::uint64_t>(n.series.end));
     for (NodeId o : n.orbit) mix(h, o);
     mix(h, bits(n.series.escape.radius));
+    if (n.exact) mix(h, std::hash<std::string>{}(n.exact->to_string()));
     return h;
 }
 
@@ -75,7 +56,8 @@ bool Graph::KeyEq::operator()(const Node& a, const Node& b) const {
            a.series.end == b.series.end && bits(a.series.gamma.lo) == bits(b.series.gamma.lo) &&
            bits(a.series.gamma.hi) == bits(b.series.gamma.hi) &&
            a.series.state_count == b.series.state_count && a.orbit == b.orbit &&
-           a.series.one_sided == b.series.one_sided && same_escape(a.series.escape, b.series.escape);
+           a.series.one_sided == b.series.one_sided && same_escape(a.series.escape, b.series.escape) &&
+           (a.exact == b.exact || (a.exact && b.exact && *a.exact == *b.exact));
 }
 
 NodeId Graph::intern(const Node& n) {
@@ -98,12 +80,88 @@ NodeId Graph::intern(const Node& n) {
 }
 
 NodeId Graph::constant(Interval value, double point) {
+    // A thin enclosure [v, v] is the exact value v: one node, whichever way it was computed (an
+    // enclosure [-0, 0] is the value 0 too; a point value -0 keeps its sign, for 1 / x).
+    if (value.is_thin() && point == value.lo && std::isfinite(point) && !(point == 0 && std::signbit(point)))
+        return constant(num::Rational::from_double(point));
     Node n;
     n.op = Op::Const;
     n.value = value;
     n.point = point;
     return intern(n);
 }
+
+NodeId Graph::constant(double exact) {
+    return constant(Interval{exact, exact}, exact); // exact unless -0, inf or NaN (see above)
+}
+
+NodeId Graph::constant(const num::Rational& exact) {
+    Node n;
+    n.op = Op::Const;
+    n.value = num::enclose(exact);
+    n.point = exact.to_double();
+    n.exact = std::make_shared<const num::Rational>(exact);
+    return intern(n);
+}
+
+namespace {
+
+// Rationals kept exact up to this size (bits of numerator and denominator): 3^20 and the like, not
+// the 2^100000 a careless power could make.
+constexpr std::size_t max_exact_bits = 4096;
+
+bool small(const num::Rational& r) {
+    return mpz_sizeinbase(r.numerator().get_mpz_t(), 2) <= max_exact_bits &&
+           mpz_sizeinbase(r.denominator().get_mpz_t(), 2) <= max_exact_bits;
+}
+
+num::Rational floor_of(const num::Rational& r) {
+    mpz_class q;
+    mpz_fdiv_q(q.get_mpz_t(), r.numerator().get_mpz_t(), r.denominator().get_mpz_t());
+    return num::Rational(mpq_class(q));
+}
+
+// The exact result of op on exact arguments, when it is rational and small; nullopt otherwise.
+std::optional<num::Rational> fold_exact(Op op, const num::Rational* const* a, std::int64_t imm) {
+    using num::Rational;
+    auto truth = [](bool t) { return Rational(t ? 1 : 0); };
+    auto integer_power = [&](const Rational& base, const Rational& e) -> std::optional<Rational> {
+        if (!e.is_integer() || abs(e) > Rational(64) || (base.is_zero() && e.sign() < 0)) return std::nullopt;
+        return pow(base, e.numerator().get_si());
+    };
+    std::optional<Rational> r;
+    switch (op) {
+    case Op::Add: r = *a[0] + *a[1]; break;
+    case Op::Sub: r = *a[0] - *a[1]; break;
+    case Op::Mul: r = *a[0] * *a[1]; break;
+    case Op::Div:
+        if (a[1]->is_zero()) return std::nullopt;
+        r = *a[0] / *a[1];
+        break;
+    case Op::Neg: r = -*a[0]; break;
+    case Op::Sqr: r = *a[0] * *a[0]; break;
+    case Op::PowI: r = integer_power(*a[0], Rational(static_cast<long>(imm))); break;
+    case Op::Pow: r = integer_power(*a[0], *a[1]); break;
+    case Op::Abs: r = abs(*a[0]); break;
+    case Op::Min: r = std::min(*a[0], *a[1]); break;
+    case Op::Max: r = std::max(*a[0], *a[1]); break;
+    case Op::Floor: r = floor_of(*a[0]); break;
+    case Op::Ceil: r = -floor_of(-*a[0]); break;
+    case Op::Mod1: r = *a[0] - floor_of(*a[0]); break;
+    case Op::Dz: r = std::min(*a[0] - floor_of(*a[0]), -floor_of(-*a[0]) - *a[0]); break;
+    case Op::Lt: r = truth(*a[0] < *a[1]); break;
+    case Op::Le: r = truth(*a[0] <= *a[1]); break;
+    case Op::Gt: r = truth(*a[0] > *a[1]); break;
+    case Op::Ge: r = truth(*a[0] >= *a[1]); break;
+    case Op::Eq: r = truth(*a[0] == *a[1]); break;
+    case Op::Ne: r = truth(*a[0] != *a[1]); break;
+    default: return std::nullopt; // transcendental, or logic on truth values (folded by intervals)
+    }
+    if (r && !small(*r)) return std::nullopt;
+    return r;
+}
+
+} // namespace
 
 NodeId Graph::var(int index) {
     Node n;
@@ -131,6 +189,13 @@ NodeId Graph::state(int level, int component) {
 
 NodeId Graph::fold(const Node& n) {
     const int k = arity(n.op);
+    // Exact arguments fold exactly where the result is rational; the enclosure is then the tightest.
+    const num::Rational* exact[3] = {nullptr, nullptr, nullptr};
+    bool all_exact = true;
+    for (int i = 0; i < k; ++i)
+        all_exact = all_exact && (exact[i] = nodes_[n.args[i]].exact.get()) != nullptr;
+    if (all_exact)
+        if (std::optional<num::Rational> r = fold_exact(n.op, exact, n.imm)) return constant(*r);
     Interval iv[3];
     double pt[3];
     for (int i = 0; i < k; ++i) {

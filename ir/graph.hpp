@@ -7,9 +7,14 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <unordered_map>
 #include <vector>
+
+namespace frac::num {
+class Rational; // numeric/rational.hpp
+} // namespace frac::num
 
 namespace frac::ir {
 
@@ -86,8 +91,12 @@ struct Node {
     std::array<NodeId, 3> args{no_node, no_node, no_node};
     Interval value{0.0, 0.0}; // Const: outward enclosure of the constant
     double point = 0.0;       // Const: its round-to-nearest value
-    std::int64_t imm = 0;     // Var: input index; Index: level; PowI: exponent
-    SeriesData series;        // series ops only
+    // Const: the exact value, when it is a rational the compiler knows (a literal as written, 1/3,
+    // 3^20 and what folds exactly from them); value and point are then its enclosure and nearest double.
+    // Null otherwise (pi, sqrt(2), an interval, a rational too large to keep).
+    std::shared_ptr<const num::Rational> exact;
+    std::int64_t imm = 0; // Var: input index; Index: level; PowI: exponent
+    SeriesData series;    // series ops only
     // Orbit series: the initial point's components, then the map's components (of State nodes).
     std::vector<NodeId> orbit;
     // Infinite series: nodes whose point values bound A and B (ir/point_bounds.hpp): lo A, hi A, lo B,
@@ -103,7 +112,12 @@ public:
     std::size_t size() const { return nodes_.size(); }
 
     NodeId constant(Interval value, double point);
-    NodeId constant(double exact) { return constant(Interval{exact, exact}, exact); }
+    // A double is a rational: an exact constant when finite.
+    NodeId constant(double exact);
+    // An exact rational constant; its enclosure is taken here, when it is lowered to the graph.
+    NodeId constant(const num::Rational& exact);
+    // The exact value of a constant node, or null.
+    const num::Rational* exact_value(NodeId id) const { return nodes_[id].exact.get(); }
     NodeId var(int index);
     NodeId index(int level);
     // Component `component` of the orbit point of the series of level `level`.

@@ -1,6 +1,7 @@
 // Text form of the expression graph (frac check --emit=ir).
 #include "ir/graph.hpp"
 #include "ir/series_tail.hpp"
+#include "numeric/rational.hpp"
 
 #include <algorithm>
 #include <fmt/format.h>
@@ -37,10 +38,11 @@ std::string print_graph(const Graph& g, const std::vector<NodeId>& roots) {
         out += fmt::format("%{} = {}", id, op_name(n.op));
         switch (op_class(n.op)) {
         case OpClass::leaf:
-            if (n.op == Op::Const)
+            if (n.op == Op::Const) {
                 out += n.value.is_thin() ? fmt::format(" {}", n.value.lo)
                                          : fmt::format(" [{}, {}] ~{}", n.value.lo, n.value.hi, n.point);
-            else if (n.op == Op::State)
+                if (n.exact && !n.value.is_thin()) out += " = " + n.exact->to_string(); // exactly 1/3
+            } else if (n.op == Op::State)
                 out += fmt::format(" {}.{}", state_level(n.imm), state_component(n.imm));
             else
                 out += fmt::format(" {}", n.imm);

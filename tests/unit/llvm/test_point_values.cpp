@@ -210,7 +210,7 @@ ir::NodeId instantiate(const ir::Graph& from, ir::NodeId root, ir::Graph& to, Bo
                 const double lo = std::fmax(n.value.lo, std::fmin(n.value.hi, 0.0) - 1e6);
                 const double hi = std::fmin(n.value.hi, std::fmax(n.value.lo, 0.0) + 1e6);
                 map[id] = n.value.is_empty()  ? to.constant(std::nan("")) // no value: undefined
-                          : n.value.is_thin() ? to.constant(n.value.lo)
+                          : n.value.is_thin() ? to.constant(n.value, n.point)
                                               : to.constant(mk.uniform(lo, hi));
             }
             break;
