@@ -145,11 +145,8 @@ TEST_CASE("series of every kind agree: finite, infinite, with B, nested, orbits"
     for (const char* e : exprs) {
         auto c = front::compile_source("t.frac", maps + "shape s(x, y) = " + e + ";");
         INFO(e);
-        if (std::string(e).find("escape") != std::string::npos) REQUIRE(c->ok());
-        if (!c->ok()) {
-            WARN("not compiled: " << c->diags.render(c->sources));
-            continue;
-        }
+        INFO(c->diags.render(c->sources));
+        REQUIRE(c->ok()); // every kind must compile: a skipped case would shrink the check silently
         const ir::Tape t = ir::build_tape(c->module.graph, c->module.shapes[0].root, 2);
         FRAC_REQUIRE_IDENTICAL(
             cross_check_all(t, {{0, 1}, {0, 1}}, 900 + static_cast<std::uint64_t>(k), 600));
