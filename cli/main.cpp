@@ -2,6 +2,8 @@
 #include "cli/commands.hpp"
 #include "frontend/suggest.hpp"
 
+#include <algorithm>
+
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <iostream>
@@ -157,6 +159,18 @@ int main(int argc, char** argv) {
     auto* help = app.add_subcommand("help", "print the help of frac or of one command");
     help->add_option("command", help_topic, "a command");
 
+    // A first word that is neither an option nor a command is a mistyped command: suggest the nearest.
+    if (argc > 1 && argv[1][0] != '-') {
+        std::vector<std::string> names;
+        for (const CLI::App* sub : app.get_subcommands({})) names.push_back(sub->get_name());
+        if (std::find(names.begin(), names.end(), argv[1]) == names.end()) {
+            const auto near = front::closest_name(argv[1], names);
+            std::cerr << fmt::format("frac: error: no command '{}'{}; the commands: {}\n", argv[1],
+                                     near ? fmt::format(" (did you mean '{}'?)", *near) : "",
+                                     front::list_names(names));
+            return front::exit_usage_error;
+        }
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
