@@ -255,20 +255,23 @@ private:
     }
 
     // Where a box is expected (`over`, enclose's box), `*` between intervals is the ASCII spelling of
+    // The box a × b of an interval or box `a` and an interval `b`.
+    Value box_product(const Value& a, const Value& b, Location loc) {
+        Value r;
+        r.kind = ValueKind::box;
+        r.box = a.box;
+        r.box.push_back(b.box[0]);
+        if (r.box.size() > 3) fail(loc, "boxes have 2 or 3 axes");
+        return r;
+    }
+
     // ×: a number is never a box, so there the product of intervals cannot be meant.
     Value expected_box(const Expr& e) {
         if (e.kind == ExprKind::binary && e.op == Tok::star) {
             const Value a = expected_box(*e.kids[0]);
             const Value b = expr(*e.kids[1]);
-            if ((a.kind == ValueKind::interval || a.kind == ValueKind::box) &&
-                b.kind == ValueKind::interval) {
-                Value r;
-                r.kind = ValueKind::box;
-                r.box = a.box;
-                r.box.push_back(b.box[0]);
-                if (r.box.size() > 3) fail(e.loc, "boxes have 2 or 3 axes");
-                return r;
-            }
+            if ((a.kind == ValueKind::interval || a.kind == ValueKind::box) && b.kind == ValueKind::interval)
+                return box_product(a, b, e.loc);
         }
         return expr(e);
     }
@@ -610,12 +613,7 @@ private:
                 fail(la, fmt::format("'×' builds a box from intervals, found {}", kind_name(a.kind)));
             if (b.kind != ValueKind::interval)
                 fail(lb, fmt::format("'×' builds a box from intervals, found {}", kind_name(b.kind)));
-            Value r;
-            r.kind = ValueKind::box;
-            r.box = a.box;
-            r.box.push_back(b.box[0]);
-            if (r.box.size() > 3) fail(e.loc, "boxes have 2 or 3 axes");
-            return r;
+            return box_product(a, b, e.loc);
         }
         case Tok::plus:
         case Tok::minus:
