@@ -11,7 +11,6 @@
 #include "runtime/slice.hpp"
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <memory>
 
 #include <algorithm>
@@ -191,12 +190,10 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
         const auto eq = o.slice.find('=');
         const std::string axis = o.slice.substr(0, eq);
         slice_axis = axis == "x" ? 0 : axis == "y" ? 1 : axis == "z" ? 2 : -1;
-        const std::string value = eq == std::string::npos ? "" : o.slice.substr(eq + 1);
-        char* end = nullptr;
-        slice_value = std::strtod(value.c_str(), &end);
-        if (eq == std::string::npos || slice_axis < 0 || value.empty() || *end != '\0' ||
-            !std::isfinite(slice_value))
+        if (eq == std::string::npos || slice_axis < 0)
             throw UsageError(fmt::format("--slice needs AXIS=VALUE such as z=0.5, not '{}'", o.slice));
+        // A constant expression, as in --at (z=1/3 is the plane nearest to 1/3).
+        slice_value = evaluate_constant(o.slice.substr(eq + 1), "--slice: the value").point;
         if (s.dimension != 3) throw UsageError(fmt::format("--slice is for 3D shapes; '{}' is 2D", s.name));
     }
     if (s.dimension == 3 && slice_axis < 0 && (!o.ascii.empty() || ends_with(o.output, ".svg")))
