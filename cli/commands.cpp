@@ -11,6 +11,7 @@
 #include "runtime/slice.hpp"
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <memory>
 
 #include <algorithm>
@@ -151,12 +152,25 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 
 namespace {
 
+// The size limit of outputs: output_size_limit, or FRAC_OUTPUT_LIMIT_MB when set to a positive number.
+double output_limit() {
+    if (const char* env = std::getenv("FRAC_OUTPUT_LIMIT_MB")) {
+        char* end = nullptr;
+        const double mb = std::strtod(env, &end);
+        if (end != env && *end == '\0' && mb > 0 && std::isfinite(mb)) return mb * 1e6;
+        throw UsageError(
+            fmt::format("FRAC_OUTPUT_LIMIT_MB must be a positive number of megabytes, not '{}'", env));
+    }
+    return output_size_limit;
+}
+
 // Refuses an output whose estimated size exceeds the limit unless forced.
 void check_output_size(const std::string& path, double bytes, bool force) {
-    if (bytes <= output_size_limit || force) return;
-    throw RunError(fmt::format("'{}' would be about {:.0f} MB (the limit is {:.0f} MB): lower --depth, or "
-                               "pass --force to write it anyway",
-                               path, bytes / 1e6, output_size_limit / 1e6));
+    const double limit = output_limit();
+    if (bytes <= limit || force) return;
+    throw RunError(fmt::format("'{}' would be about {:.0f} MB (the limit is {:g} MB, FRAC_OUTPUT_LIMIT_MB): "
+                               "lower --depth, or pass --force to write it anyway",
+                               path, bytes / 1e6, limit / 1e6));
 }
 
 } // namespace

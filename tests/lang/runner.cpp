@@ -9,6 +9,7 @@
 //                                           (every error on stderr must be expected)
 //   // expect stderr: TEXT                  some line of stderr contains TEXT
 //   // expect exit: N                       exit status (default 0, or 65 with expected errors)
+//   // env: NAME=VALUE                      an environment setting for the command
 // Run as `lang_runner FRAC FILE ENGINE`, a command that evaluates (eval, render, mesh, dimension, test,
 // run) gets `--engine ENGINE`, unless its args name one; output files under /tmp/frac-lang- then get
 // the engine in their name, so that the runs under each engine can go on at once. CMake registers a file
@@ -60,7 +61,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     const std::string frac = argv[1], file = argv[2], engine = argc == 4 ? argv[3] : "";
-    std::string args = "run";
+    std::string args = "run", env; // env: NAME=VALUE settings for the command
     std::vector<std::string> want_out, want_errors, want_stderr;
     int want_exit = -1;
     for (const std::string& line : lines(read(file))) {
@@ -72,6 +73,8 @@ int main(int argc, char** argv) {
         };
         if (d.rfind("args:", 0) == 0)
             args = trim(value("args:"));
+        else if (d.rfind("env:", 0) == 0)
+            env += trim(value("env:")) + " ";
         else if (d.rfind("expect error:", 0) == 0)
             want_errors.push_back(trim(value("expect error:")));
         else if (d.rfind("expect stderr:", 0) == 0)
@@ -110,7 +113,7 @@ int main(int argc, char** argv) {
             for (std::string& w : *list) rename(w);
     }
     const std::string cmd =
-        quote(frac) + " " + command_line + " >" + out_path + " 2>" + err_path + " </dev/null";
+        env + quote(frac) + " " + command_line + " >" + out_path + " 2>" + err_path + " </dev/null";
     const int status = std::system(cmd.c_str());
     const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     const auto out = lines(read(out_path)), err = lines(read(err_path));
