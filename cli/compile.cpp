@@ -1,10 +1,6 @@
-// frac compile: shapes -> an object file or a shared library with the C ABI of docs/c-abi.md.
-//
-// The generated code (backend/llvm/aot.cpp) is linked with the run-time archive libfrac_aot_runtime.a
-// (`ld -r`, only the members it needs), then every symbol but the exported functions is made local
-// and COMDAT groups are dissolved (`objcopy`), so that several compiled models can live in one program. A
-// shared library is that object linked by the C++ driver (it needs the system's libstdc++ and libm, nothing
-// of Frac or LLVM).
+// frac compile: shapes -> an object file or a shared library with the C ABI of docs/c-abi.md. The code
+// is generated (backend/llvm/aot.cpp) and linked with the run-time archive (aot_build.cpp) by the backend;
+// this file checks the command line and the outputs, and writes the header.
 #include "backend/llvm/aot.hpp"
 #include "backend/llvm/jit.hpp"
 #include "cli/commands.hpp"
@@ -14,16 +10,10 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-extern char** environ;
 
 namespace frac::cli {
 namespace fs = std::filesystem;
@@ -33,76 +23,6 @@ namespace {
 bool ends_with(const std::string& s, const std::string& suffix) {
     return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
-
-// A configured tool if it is there, else the same name looked up in PATH.
-std::string tool(const char* configured, const char* fallback) {
-    std::error_code ec;
-    if (configured[0] != '\0' && fs::exists(configured, ec)) return configured;
-    return fallback;
-}
-
-void run_tool(const std::vector<std::string>& args, const std::string& what) {
-    std::vector<char*> argv;
-    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    std::string line;
-    for (const std::string& a : args) line += (line.empty() ? "" : " ") + a;
-    pid_t pid = 0;
-    if (const int err = posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ); err != 0)
-        throw RunError(fmt::format("{}: cannot run '{}': {}", what, args[0], std::strerror(err)));
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0)
-        if (errno != EINTR)
-            throw RunError(fmt::format("{}: lost '{}': {}", what, args[0], std::strerror(errno)));
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-        throw RunError(fmt::format("{} failed ({}): {}", what,
-                                   WIFEXITED(status) ? fmt::format("exit status {}", WEXITSTATUS(status))
-                                                     : std::string("killed by a signal"),
-                                   line));
-}
-
-// The run-time archive: $FRAC_AOT_RUNTIME, next to the frac binary, or where the build put it.
-std::string find_runtime_archive() {
-    const char* name = "libfrac_aot_runtime.a";
-    std::vector<fs::path> tried;
-    if (const char* env = std::getenv("FRAC_AOT_RUNTIME"); env && *env) {
-        if (fs::exists(env)) return env;
-        throw RunError(fmt::format("FRAC_AOT_RUNTIME names '{}', which does not exist", env));
-    }
-    std::error_code ec;
-    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-    if (!ec) tried.push_back(self.parent_path() / name);
-    tried.push_back(FRAC_AOT_RUNTIME_PATH);
-    std::string list;
-    for (const fs::path& p : tried) {
-        if (fs::exists(p, ec)) return p.string();
-        list += (list.empty() ? "" : ", ") + p.string();
-    }
-    throw RunError(fmt::format("cannot find the run-time archive of compiled models ({}); build the "
-                               "frac_aot_runtime target or set FRAC_AOT_RUNTIME",
-                               list));
-}
-
-// A fresh private directory for the intermediate files, removed on scope exit.
-class TempDir {
-public:
-    TempDir() {
-        std::string pattern = (fs::temp_directory_path() / "frac-compile-XXXXXX").string();
-        if (!mkdtemp(pattern.data()))
-            throw RunError(fmt::format("cannot create a temporary directory: {}", std::strerror(errno)));
-        path_ = pattern;
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-    std::string file(const char* name) const { return (path_ / name).string(); }
-
-private:
-    fs::path path_;
-};
 
 // Fails early, with the system's reason, when `path` cannot be written.
 void check_writable(const std::string& path) {
@@ -194,39 +114,14 @@ int run_compile(const std::string& file, const CompileOptions& o) {
         if (!existed) outputs.add(path);
     }
 
-    const std::string archive = ir_only ? std::string() : find_runtime_archive();
-    TempDir tmp;
-    const std::string generated = ir_only ? std::string() : tmp.file("generated.o");
     jit::AotInfo info;
     try {
-        info = jit::compile_aot(shapes, config, generated, ir_path);
+        info = ir_only ? jit::compile_aot(shapes, config, "", ir_path)
+                       : jit::build_aot(shapes, config, o.output, ir_path);
     } catch (const std::invalid_argument& e) {
         throw RunError(e.what());
     } catch (const jit::JitError& e) {
         throw RunError(e.what());
-    }
-
-    if (!ir_only) {
-        const std::string combined = tmp.file("combined.o");
-        run_tool({tool(FRAC_AOT_LD, "ld"), "-r", "-o", combined, generated, archive},
-                 "linking the run-time support into the model");
-        const std::string object = ends_with(o.output, ".o") ? o.output : tmp.file("model.o");
-        // Local symbols in COMDAT groups would still be merged with another model's copies (and the
-        // references to the discarded copy break): the groups go, each model keeps its own code.
-        std::vector<std::string> localize = {tool(FRAC_AOT_OBJCOPY, "objcopy"), "--strip-debug",
-                                             "--remove-section=.group"};
-        for (const jit::AotShape& s : shapes)
-            for (const char* f :
-                 {"eval_point", "eval_points", "eval_box", "eval_boxes", "dimension", "default_box"})
-                localize.push_back("--keep-global-symbol=" + jit::aot_symbol(config, s.name, f));
-        localize.push_back(combined);
-        localize.push_back(object);
-        run_tool(localize, "keeping only the model's functions global");
-        if (ends_with(o.output, ".so"))
-            run_tool({tool(FRAC_AOT_CXX, "c++"), "-shared", "-o", o.output,
-                      "-Wl,-soname," + fs::path(o.output).filename().string(), object, "-Wl,-z,noexecstack",
-                      "-lm"},
-                     "linking the shared library");
     }
     if (!o.header.empty()) {
         std::ofstream h(o.header, std::ios::binary | std::ios::trunc);

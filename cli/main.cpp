@@ -24,8 +24,9 @@ int main(int argc, char** argv) {
             ->allow_extra_args(false);
     };
     auto add_engine = [&](CLI::App* sub) {
-        sub->add_option("--engine", engine.engine, "evaluation engine: jit or interp")
-            ->check(CLI::IsMember({"jit", "interp"}))
+        sub->add_option("--engine", engine.engine,
+                        "evaluation engine: jit, interp or aot (compiled as by frac compile, then loaded)")
+            ->check(CLI::IsMember({"jit", "interp", "aot"}))
             ->capture_default_str();
         sub->add_option("--max-terms", engine.eval.max_terms,
                         "most terms of an infinite series before its tail bound")

@@ -1,6 +1,7 @@
 #include "cli/session.hpp"
 
 #include "backend/interp/interpreter.hpp"
+#include "backend/llvm/aot.hpp"
 #include "backend/llvm/jit.hpp"
 #include "runtime/dimension.hpp"
 #include "runtime/rss.hpp"
@@ -95,8 +96,15 @@ std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId
         if (!told)
             std::cerr << fmt::format("frac: note: the JIT cannot be used ({}); using the interpreter\n", why);
         told = true;
+    } else if (options.engine == "aot") {
+        // Asked for by name, so no fallback: a model that cannot be compiled and loaded is an error.
+        try {
+            return jit::make_aot(tape, options.eval);
+        } catch (const jit::JitError& e) {
+            throw RunError(fmt::format("the aot engine cannot be used: {}", e.what()));
+        }
     } else if (options.engine != "interp") {
-        throw RunError(fmt::format("unknown engine '{}' (available: jit, interp)", options.engine));
+        throw RunError(fmt::format("unknown engine '{}' (available: jit, interp, aot)", options.engine));
     }
     return interp::make_interpreter(std::move(tape), options.eval);
 }

@@ -13,7 +13,7 @@
 namespace frac::cli {
 
 struct EngineOptions {
-    std::string engine = "jit"; // the interpreter is the fallback when the JIT cannot be used
+    std::string engine = "jit"; // or "interp" (the fallback when the JIT cannot be used), "aot"
     ir::EvalOptions eval;
     int threads = 0; // subdivision threads; 0: all cores
 };

@@ -2,8 +2,10 @@
 //
 // The same code generator as the JIT (codegen.hpp) emits each shape's batch functions into one LLVM
 // module; exported C wrappers with stable names are added around them, and LLVM's TargetMachine writes
-// the object. The object still calls the numeric core: `frac compile` links it with
-// libfrac_aot_runtime.a (aot_runtime.hpp, helpers.hpp, the numeric core, LLVM libc), see cli/compile.cpp.
+// the object (compile_aot). The object still calls the numeric core: build_aot links it with
+// libfrac_aot_runtime.a (aot_runtime.hpp, helpers.hpp, the numeric core, LLVM libc) into a
+// self-contained object or a shared library (`frac compile`), and make_aot loads such a library into
+// this process as an evaluator (`--engine aot`, the conformance suite).
 //
 // Only backend/llvm includes LLVM headers; this header does not.
 #pragma once
@@ -11,6 +13,7 @@
 #include "ir/evaluator.hpp"
 #include "ir/tape.hpp"
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -52,6 +55,22 @@ bool is_c_identifier(const std::string& name);
 // std::invalid_argument for options out of range or a CPU LLVM does not know.
 AotInfo compile_aot(const std::vector<AotShape>& shapes, const AotConfig& config,
                     const std::string& object_path, const std::string& llvm_ir_path);
+
+// compile_aot, then the object linked with the run-time archive into `output`: a relocatable object
+// (.o) or a shared library (.so) whose only global symbols are the exported functions (docs/c-abi.md,
+// "Linking"). Throws as compile_aot, and JitError when the run-time archive cannot be found (it is
+// looked for before any work) or a linker step fails.
+AotInfo build_aot(const std::vector<AotShape>& shapes, const AotConfig& config, const std::string& output,
+                  const std::string& llvm_ir_path = "");
+
+// An evaluator over `tape` compiled ahead of time: build_aot writes a shared library to a temporary
+// directory, dlopen loads it, and the evaluator calls its C functions (engine "aot"). The options are
+// baked into the code. What the C ABI does not offer: series counters (stats counts calls only), min/max
+// pruning (specialize() returns null), and a box with an empty coordinate has the empty image where
+// the other engines evaluate the function on it (docs/c-abi.md). Otherwise the results are the
+// JIT's bits. `cpu` as AotConfig::cpu. Throws as build_aot, and JitError when loading fails.
+std::unique_ptr<ir::Evaluator> make_aot(const ir::Tape& tape, const ir::EvalOptions& options = {},
+                                        const std::string& cpu = "native");
 
 // The C header declaring the functions of `shapes` (with comments: layouts, rounding contract, limits).
 std::string aot_header(const std::vector<AotShape>& shapes, const AotConfig& config, const AotInfo& info,

@@ -13,7 +13,8 @@
 // Run as `lang_runner FRAC FILE ENGINE`, a command that evaluates (eval, render, mesh, dimension, test,
 // run) gets `--engine ENGINE`, unless its args name one; output files under /tmp/frac-lang- then get
 // the engine in their name, so that the runs under each engine can go on at once. CMake registers a file
-// once per engine (both by default; `// engines: interp` limits it), and once for other commands.
+// once per engine (interp, jit and aot by default; `// engines: interp jit` limits it), and once for
+// other commands.
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>

@@ -1,8 +1,9 @@
-// Shared pieces of the LLVM backend's tests: the two engines as template parameters, shape
-// compilation, random boxes and points, and bit-exact comparison.
+// Shared pieces of the LLVM backend's tests and of the conformance suite (tests/conformance): the
+// engines as template parameters, shape compilation, random boxes and points, and bit-exact comparison.
 #pragma once
 
 #include "backend/interp/interpreter.hpp"
+#include "backend/llvm/aot.hpp"
 #include "backend/llvm/jit.hpp"
 #include "frontend/driver.hpp"
 #include "ir/graph.hpp"
@@ -21,17 +22,28 @@ namespace frac::test {
 
 using ir::Interval;
 
-// The engines the conformance suite is instantiated for.
+// The engines the conformance suite is instantiated for. `counts_series`: the engine reports series
+// terms and capped series in EvalStats (compiled models have no counters in their C ABI).
 struct InterpEngine {
     static constexpr const char* name = "interp";
+    static constexpr bool counts_series = true;
     static std::unique_ptr<ir::Evaluator> make(const ir::Tape& t, const ir::EvalOptions& o = {}) {
         return interp::make_interpreter(t, o);
     }
 };
 struct JitEngine {
     static constexpr const char* name = "jit";
+    static constexpr bool counts_series = true;
     static std::unique_ptr<ir::Evaluator> make(const ir::Tape& t, const ir::EvalOptions& o = {}) {
         return jit::make_jit(t, o);
+    }
+};
+// The tape compiled as `frac compile -o model.so` compiles it, loaded with dlopen (backend/llvm/aot.hpp).
+struct AotEngine {
+    static constexpr const char* name = "aot";
+    static constexpr bool counts_series = false;
+    static std::unique_ptr<ir::Evaluator> make(const ir::Tape& t, const ir::EvalOptions& o = {}) {
+        return jit::make_aot(t, o);
     }
 };
 
@@ -80,6 +92,37 @@ inline std::vector<std::string> stdlib_files() {
     for (const auto& [name, text] : front::embedded_stdlib()) names.push_back(name);
     return names;
 }
+
+// Series of every kind, as shapes over x, y: finite and infinite, with B, nested, orbits, escape
+// certificates. Every one must compile: a skipped case would shrink the checks silently.
+inline const std::vector<std::string>& series_kinds() {
+    static const std::vector<std::string> exprs = {
+        "sum(i in 0..5, x^i) - y",
+        "min(i in 2..9, dz(2^i * x) - y / i)",
+        "max(i in 0..0, x * i + y)",
+        "y - sum(i in 0.., dz(2^i * x) / 2^i)",
+        "y - sum(i in 1.., floor(i * x) / 2^i)",
+        "y - max(i in 0.., (dz(3^i * x) - 1/3) / 3^i)",
+        "min(i in 0.., (1/3 - min(dz(3^i * x), dz(3^i * y))) / 3^i)",
+        "y - sum(i in 0.., sum(j in 0..3, dz(2^j * x) / 2^j) / 4^i)",
+        "y - sum(i in 0.., sin(2^i * x) * x / 2^i)",
+        "y - sum(i in 1.., i * x / 3^i)",
+        "min(k in 0.., p in orbit((x, y), shrink), (sqrt(p.x^2 + p.y^2) - 0.3) / 2^k)",
+        "min(k in 0.., p in orbit((x, y), swap), (dz(p.x) - 0.5 * dz(p.y)) / 2^k)",
+        "max(k in 0.., p in orbit((x, y), grow), (dz(p.x) - abs(p.y)) / 3^k)",
+        // Escape certificates (frontend/orbit_escape): tails tightened from the orbit box.
+        "min(k in 0.., p in orbit((x, y), grow) escape 1/2, (sqrt(p.x^2 + p.y^2) - 0.2) / 3^k)",
+        "max(k in 0.., p in orbit((x, y), grow) escape 1, (0.7 - sqrt(p.x^2 + p.y^2)) / 3^k) + 0.01",
+        "min(k in 0.., p in orbit((x, y), fold) escape 1/2, (sqrt(p.x^2 + p.y^2) - 0.28) / 3^k)",
+    };
+    return exprs;
+}
+// The maps the orbits of series_kinds() use, to put before the shape.
+inline const std::string series_maps =
+    "fn shrink(p) = (p.x / 2 + 0.1, p.y / 2); fn swap(p) = (p.y, p.x);"
+    "fn grow(p) = (3 * p.x, 3 * p.y - 1);"
+    "fn fold(p) = let r = sqrt(p.x^2 + p.y^2), f = pi / 3 * (2 * dz(atan2(abs(p.y), p.x) * "
+    "3 / pi / 2 + 1/4) - 1/2) in (3 * r * cos(f) - 1, 3 * r * sin(f));";
 
 // Random boxes that stress the interval code: thin boxes, tiny to huge widths, boxes on integers,
 // half-integers and thirds (where dz, floor and mod1 change), boxes around 0, unbounded coordinates.

@@ -117,33 +117,9 @@ TEST_CASE("an expression for every opcode agrees", "[llvm][crosscheck]") {
 }
 
 TEST_CASE("series of every kind agree: finite, infinite, with B, nested, orbits", "[llvm][crosscheck]") {
-    const char* exprs[] = {
-        "sum(i in 0..5, x^i) - y",
-        "min(i in 2..9, dz(2^i * x) - y / i)",
-        "max(i in 0..0, x * i + y)",
-        "y - sum(i in 0.., dz(2^i * x) / 2^i)",
-        "y - sum(i in 1.., floor(i * x) / 2^i)",
-        "y - max(i in 0.., (dz(3^i * x) - 1/3) / 3^i)",
-        "min(i in 0.., (1/3 - min(dz(3^i * x), dz(3^i * y))) / 3^i)",
-        "y - sum(i in 0.., sum(j in 0..3, dz(2^j * x) / 2^j) / 4^i)",
-        "y - sum(i in 0.., sin(2^i * x) * x / 2^i)",
-        "y - sum(i in 1.., i * x / 3^i)",
-        "min(k in 0.., p in orbit((x, y), shrink), (sqrt(p.x^2 + p.y^2) - 0.3) / 2^k)",
-        "min(k in 0.., p in orbit((x, y), swap), (dz(p.x) - 0.5 * dz(p.y)) / 2^k)",
-        "max(k in 0.., p in orbit((x, y), grow), (dz(p.x) - abs(p.y)) / 3^k)",
-        // Escape certificates (frontend/orbit_escape): tails tightened from the orbit box.
-        "min(k in 0.., p in orbit((x, y), grow) escape 1/2, (sqrt(p.x^2 + p.y^2) - 0.2) / 3^k)",
-        "max(k in 0.., p in orbit((x, y), grow) escape 1, (0.7 - sqrt(p.x^2 + p.y^2)) / 3^k) + 0.01",
-        "min(k in 0.., p in orbit((x, y), fold) escape 1/2, (sqrt(p.x^2 + p.y^2) - 0.28) / 3^k)",
-    };
-    const std::string maps =
-        "fn shrink(p) = (p.x / 2 + 0.1, p.y / 2); fn swap(p) = (p.y, p.x);"
-        "fn grow(p) = (3 * p.x, 3 * p.y - 1);"
-        "fn fold(p) = let r = sqrt(p.x^2 + p.y^2), f = pi / 3 * (2 * dz(atan2(abs(p.y), p.x) * "
-        "3 / pi / 2 + 1/4) - 1/2) in (3 * r * cos(f) - 1, 3 * r * sin(f));";
     int k = 0;
-    for (const char* e : exprs) {
-        auto c = front::compile_source("t.frac", maps + "shape s(x, y) = " + e + ";");
+    for (const std::string& e : series_kinds()) {
+        auto c = front::compile_source("t.frac", series_maps + "shape s(x, y) = " + e + ";");
         INFO(e);
         INFO(c->diags.render(c->sources));
         REQUIRE(c->ok()); // every kind must compile: a skipped case would shrink the check silently
