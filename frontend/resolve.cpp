@@ -1,7 +1,7 @@
 #include "frontend/resolve.hpp"
 
 #include "frontend/builtins.hpp"
-#include "frontend/driver.hpp"
+#include "frontend/loader.hpp"
 #include "frontend/suggest.hpp"
 
 #include <algorithm>

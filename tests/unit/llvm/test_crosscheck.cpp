@@ -143,7 +143,7 @@ TEST_CASE("series of every kind agree: finite, infinite, with B, nested, orbits"
         "3 / pi / 2 + 1/4) - 1/2) in (3 * r * cos(f) - 1, 3 * r * sin(f));";
     int k = 0;
     for (const char* e : exprs) {
-        auto c = front::compile_source("t.frac", maps + "shape s(x, y) = " + e + ";");
+        auto c = driver::compile_source("t.frac", maps + "shape s(x, y) = " + e + ";");
         INFO(e);
         INFO(c->diags.render(c->sources));
         REQUIRE(c->ok()); // every kind must compile: a skipped case would shrink the check silently

@@ -1,0 +1,36 @@
+#include "driver/engines.hpp"
+
+#include "backend/interp/interpreter.hpp"
+#include "backend/llvm/jit.hpp"
+#include "ir/tape.hpp"
+
+#include <fmt/format.h>
+#include <iostream>
+
+namespace frac::driver {
+
+std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId root, int inputs,
+                                              const EngineOptions& options) {
+    ir::Tape tape = ir::build_tape(m.graph, root, inputs);
+    if (std::string defect = ir::verify_tape(tape); !defect.empty())
+        throw front::InternalError("malformed tape: " + defect);
+    if (options.engine == "jit") {
+        std::string why;
+        if (jit::jit_available(&why)) {
+            try {
+                return jit::make_jit(tape, options.eval);
+            } catch (const jit::JitError& e) {
+                why = e.what();
+            }
+        }
+        static bool told = false; // say it once per run
+        if (!told)
+            std::cerr << fmt::format("frac: note: the JIT cannot be used ({}); using the interpreter\n", why);
+        told = true;
+    } else if (options.engine != "interp") {
+        throw RunError(fmt::format("unknown engine '{}' (available: jit, interp)", options.engine));
+    }
+    return interp::make_interpreter(std::move(tape), options.eval);
+}
+
+} // namespace frac::driver
