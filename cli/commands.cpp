@@ -57,10 +57,14 @@ int run_check(const std::string& file, const std::string& emit, const std::strin
         const auto own = [](const auto& items) {
             return std::count_if(items.begin(), items.end(), [](const auto& i) { return i.loc.file == 1; });
         };
-        const auto counted = [](std::ptrdiff_t n, const char* noun) {
-            return fmt::format("{} {}{}", n, noun, n == 1 ? "" : "s");
+        const auto counted = [](std::ptrdiff_t n, const char* noun, const char* nouns = nullptr) {
+            return n == 1  ? fmt::format("1 {}", noun)
+                   : nouns ? fmt::format("{} {}", n, nouns)
+                           : fmt::format("{} {}s", n, noun);
         };
-        std::cout << fmt::format("{}: ok ({}, {})\n", file, counted(own(m.shapes), "shape"),
+        const auto automata = own(m.automata);
+        std::cout << fmt::format("{}: ok ({}{}, {})\n", file, counted(own(m.shapes), "shape"),
+                                 automata ? ", " + counted(automata, "automaton", "automata") : "",
                                  counted(own(m.tests), "test"));
     }
     return 0;

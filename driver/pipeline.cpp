@@ -21,6 +21,7 @@ const std::vector<StageInfo>& stages() {
         {Stage::resolve, "resolve", "the definitions every name resolves to"},
         {Stage::typecheck, "typecheck", "the type of every definition and function instance"},
         {Stage::lower, "lower", "the expression graph of each shape (constants folded, series bounded)"},
+        {Stage::automaton, "automaton", "the automaton IR of each ifs and cifs (lowered with the shapes)"},
         {Stage::tape, "tape", "the instruction tape of each shape"},
         {Stage::specialize, "specialize", "each shape's tape pruned over its default box"},
         {Stage::codegen, "codegen", "the JIT's optimised LLVM module of each shape"},
@@ -123,6 +124,7 @@ const char* item_kind_name(front::ItemKind k) {
     case front::ItemKind::shape: return "shape";
     case front::ItemKind::test: return "test";
     case front::ItemKind::print: return "print";
+    case front::ItemKind::automaton: return "automaton";
     }
     return "?";
 }
@@ -198,6 +200,12 @@ std::string emit(const front::Compilation& c, Stage stage, const std::vector<std
     case Stage::parse: return front::print_ast(c.program, main_file);
     case Stage::resolve: return definitions_text(c);
     case Stage::typecheck: return front::print_types(c.program, c.typed, main_file);
+    case Stage::automaton: {
+        std::string out;
+        for (const front::AutomatonInfo& a : c.module.automata)
+            if (a.loc.file == main_file) out += ir::print_automaton(a.automaton);
+        return out;
+    }
     default: break;
     }
     const front::Module& m = c.module;

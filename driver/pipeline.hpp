@@ -1,6 +1,7 @@
 // The pipeline from source to evaluator, every stage in order (pipeline.cpp holds the list):
 //
 //   lex -> parse -> resolve -> typecheck -> lower (and verify)     (frontend, once per model)
+//   -> automaton                                                   (the automaton IR of each ifs, cifs)
 //   -> tape -> specialize -> codegen                               (backend, per shape)
 //
 // Each stage can print what it produced (frac check --emit=<stage>) and is timed
@@ -16,7 +17,7 @@
 
 namespace frac::driver {
 
-enum class Stage { lex, parse, resolve, typecheck, lower, tape, specialize, codegen };
+enum class Stage { lex, parse, resolve, typecheck, lower, automaton, tape, specialize, codegen };
 
 struct StageInfo {
     Stage stage;

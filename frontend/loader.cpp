@@ -46,14 +46,11 @@ class Qualifier {
 public:
     Qualifier(const std::string& alias, Program& module) : alias_(alias) {
         for (const Item& it : module.items)
-            if (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape)
-                globals_.insert(it.name);
+            if (is_definition(it.kind)) globals_.insert(it.name);
     }
 
     void rename(Item& it) {
-        if (globals_.count(it.name) &&
-            (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape))
-            it.name = qualified(it.name);
+        if (globals_.count(it.name) && is_definition(it.kind)) it.name = qualified(it.name);
         locals_.clear();
         std::set<std::string> params;
         for (const Param& p : it.params) params.insert(p.name);
@@ -65,9 +62,25 @@ public:
             expr(*e.expr);
             if (e.within) expr(*e.within);
         }
+        if (it.automaton) {
+            // The automaton is shared with the item only: it can be renamed in place.
+            for (StateDecl& st : it.automaton->states) {
+                if (!it.automaton->graph_directed) st.name = it.name;
+                if (st.primitive) expr(*st.primitive);
+            }
+            for (ArcDecl& arc : it.automaton->arcs) {
+                if (!it.automaton->graph_directed) arc.from = arc.to = it.name;
+                expr(*arc.op);
+                if (arc.probability) expr(*arc.probability);
+            }
+            if (it.automaton->projection) expr(*it.automaton->projection);
+        }
     }
 
 private:
+    static bool is_definition(ItemKind k) {
+        return k == ItemKind::fn || k == ItemKind::const_ || k == ItemKind::shape || k == ItemKind::automaton;
+    }
     std::string qualified(const std::string& name) const { return alias_ + "." + name; }
     bool global(const std::string& name) const {
         for (const auto& scope : locals_)

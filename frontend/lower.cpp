@@ -2,6 +2,7 @@
 
 #include "frontend/builtins.hpp"
 #include "frontend/inliner.hpp"
+#include "frontend/operators.hpp"
 #include "frontend/orbit_escape.hpp"
 #include "frontend/series_bounds.hpp"
 #include "frontend/typecheck.hpp"
@@ -32,7 +33,9 @@ struct Value {
     // A function passed as an argument (resolve_names checked its uses): inlined where it is called.
     const Item* function = nullptr;
     const Builtin* builtin = nullptr;
-    std::shared_ptr<const Closure> closure; // an anonymous function
+    std::shared_ptr<const Closure> closure;    // an anonymous function
+    const Item* automaton = nullptr;           // an ifs or cifs named as a value (dimension, dist)
+    std::shared_ptr<const LinearValue> linear; // a matrix or a transform (operators of automata)
 
     static Value of(ValueKind kind, NodeId n) {
         Value v;
@@ -47,6 +50,11 @@ struct Value {
     Type type() const {
         if (shape) return Type{Type::Kind::shape};
         if (function || builtin || closure) return Type{Type::Kind::function};
+        if (automaton) return Type{Type::Kind::automaton};
+        if (linear && linear->transform) return Type::transform(linear->dimension);
+        if (linear)
+            return Type::matrix(static_cast<int>(linear->in(0).rows()),
+                                static_cast<int>(linear->in(0).cols()));
         switch (kind) {
         case ValueKind::scalar: return Type::number();
         case ValueKind::boolean: return Type::boolean();
@@ -74,12 +82,16 @@ public:
 
     void run() {
         for (const Item& it : p_.items) {
-            if (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape)
+            if (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape ||
+                it.kind == ItemKind::automaton)
                 globals_[it.name] = &it;
         }
-        // Shapes first, in source order, so that tests can refer to any of them.
+        // Shapes first, in source order, so that tests can refer to any of them; then automata.
         for (const Item& it : p_.items)
             if (it.kind == ItemKind::shape && !typed_.failed.count(&it)) guarded([&] { shape_info(it); });
+        for (const Item& it : p_.items)
+            if (it.kind == ItemKind::automaton && !typed_.failed.count(&it))
+                guarded([&] { automaton_info(it); });
         for (const Item& it : p_.items) {
             if (typed_.failed.count(&it)) continue; // its type error is reported
             switch (it.kind) {
@@ -88,7 +100,8 @@ public:
             case ItemKind::print: guarded([&] { print(it); }); break;
             case ItemKind::import:
             case ItemKind::fn:
-            case ItemKind::shape: break;
+            case ItemKind::shape:
+            case ItemKind::automaton: break;
             }
         }
     }
@@ -295,6 +308,7 @@ private:
             return r;
         }
         case ExprKind::series: return series(e);
+        case ExprKind::matrix: return matrix(e);
         case ExprKind::lambda: {
             Value v;
             v.closure = std::make_shared<const Closure>(Closure{&e, frames_.back().scopes});
@@ -320,9 +334,12 @@ private:
             const Item& it = *g->second;
             if (it.kind == ItemKind::const_) return const_value(it, e.loc);
             Value v;
-            (it.kind == ItemKind::shape ? v.shape : v.function) = &it;
+            (it.kind == ItemKind::shape       ? v.shape
+             : it.kind == ItemKind::automaton ? v.automaton
+                                              : v.function) = &it;
             return v;
         }
+        if (e.text == "identity") return linear_value(front::identity());
         if (e.text == "pi") return Value::scalar(g_.constant(num::pi(), M_PI));
         if (e.text == "e") return Value::scalar(g_.constant(num::e(), M_E));
         if (const Builtin* b = find_builtin(e.text)) {
@@ -392,8 +409,158 @@ private:
         case BuiltinKind::pow: return Value::scalar(power(arg(0), arg(1)));
         case BuiltinKind::enclose:
         case BuiltinKind::dimension: return query(e, *b);
+        case BuiltinKind::transform: {
+            std::vector<Entry> args;
+            for (const Arg& a : e.args) args.push_back(entry(expr(*a.value), a.loc));
+            if (e.text == "translate") return linear_value(translate(args));
+            if (e.text == "scale") return linear_value(scale(args));
+            if (e.text == "shear") return linear_value(shear(args[0], args[1]));
+            // rotate(angle): its cosine and sine folded as constants of the graph.
+            const NodeId angle = arg(0);
+            return linear_value(rotate(entry(Value::scalar(g_.op(Op::Cos, angle)), e.loc),
+                                       entry(Value::scalar(g_.op(Op::Sin, angle)), e.loc)));
+        }
+        case BuiltinKind::controls: {
+            std::vector<std::vector<Entry>> points;
+            for (const Arg& a : e.args) {
+                std::vector<Entry> p;
+                for (NodeId n : expr(*a.value).nodes) p.push_back(entry(Value::scalar(n), a.loc));
+                points.push_back(std::move(p));
+            }
+            return linear_value(LinearValue::matrix(controls(points)));
+        }
+        case BuiltinKind::primitive: break; // only after `primitive` (automaton_info)
         }
         throw InternalError("unknown builtin kind");
+    }
+
+    // ---- operators and automata ----
+    static Value linear_value(LinearValue l) {
+        Value v;
+        v.linear = std::make_shared<const LinearValue>(std::move(l));
+        return v;
+    }
+
+    // A constant entry of an operator, exact when it folded exactly.
+    Entry entry(const Value& v, Location loc) {
+        const NodeId n = scalar(v, loc);
+        if (!g_.is_const(n)) fail(loc, "the entries of an operator must be constants");
+        Entry x;
+        if (const num::Rational* q = g_.exact_value(n)) x.exact = *q;
+        x.enclosure = g_[n].value;
+        if (!std::isfinite(x.enclosure.lo) || !std::isfinite(x.enclosure.hi))
+            fail(loc, "the entries of an operator must be finite");
+        return x;
+    }
+
+    Value matrix(const Expr& e) {
+        std::vector<std::vector<Entry>> rows;
+        for (const ExprPtr& row : e.kids) {
+            rows.emplace_back();
+            for (const ExprPtr& k : row->kids) rows.back().push_back(entry(expr(*k), k->loc));
+        }
+        return linear_value(LinearValue::matrix(operator_of(rows)));
+    }
+
+    Value linear_arithmetic(const Expr& e, const Value& a, const Value& b) {
+        const Location la = e.kids[0]->loc, lb = e.kids[1]->loc;
+        if (e.op == Tok::star && a.linear && b.linear) return linear_value(compose(*a.linear, *b.linear));
+        if (e.op == Tok::star && a.linear && b.kind == ValueKind::point) {
+            std::vector<std::vector<Entry>> column;
+            for (NodeId n : b.nodes) column.push_back({entry(Value::scalar(n), lb)});
+            const ir::Operator p = compose(a.linear->in(0), operator_of(column));
+            Value r;
+            r.kind = ValueKind::point;
+            for (std::size_t i = 0; i < p.rows(); ++i) {
+                const num::Interval v = p.enclosure(i, 0);
+                r.nodes.push_back(p.exact ? g_.constant((*p.exact)(i, 0)) : g_.constant(v, num::midpoint(v)));
+            }
+            return r;
+        }
+        if (e.op == Tok::star) {
+            const bool left = !a.linear; // number * matrix or matrix * number
+            return linear_value(LinearValue::matrix(
+                scale_by(entry(left ? a : b, left ? la : lb), (left ? b : a).linear->in(0))));
+        }
+        return linear_value(LinearValue::matrix(add(a.linear->in(0), b.linear->in(0), e.op == Tok::minus)));
+    }
+
+    // The operator of an arc, as a matrix from the space of `to` into the space of `from`.
+    ir::Operator arc_operator(const Value& v, const ir::Space& from) {
+        return v.linear->transform ? v.linear->in(from.dimension) : v.linear->in(0);
+    }
+
+    static ir::Space space_of(const SpaceDecl& s) {
+        return s.barycentric ? ir::Space::barycentric(s.n) : ir::Space::euclidean(s.n);
+    }
+
+    // What a state draws, as homogeneous columns of its space (the type checker checked the form).
+    ir::Primitive primitive_of(const StateDecl& s, const ir::Space& space) {
+        ir::Primitive p;
+        const Expr& e = *s.primitive;
+        if (e.kind == ExprKind::name) {
+            p.kind = ir::Primitive::Kind::shape;
+            p.shape = shape_info(*globals_.at(e.text));
+            return p;
+        }
+        p.kind = e.text == "point"     ? ir::Primitive::Kind::points
+                 : e.text == "polygon" ? ir::Primitive::Kind::polygon
+                                       : ir::Primitive::Kind::polyline;
+        const std::size_t n = static_cast<std::size_t>(space.coordinates());
+        if (e.args.empty()) { // a barycentric state: its vertices
+            p.points = num::Matrix<double>(n, n);
+            for (std::size_t i = 0; i < n; ++i) p.points(i, i) = 1;
+            return p;
+        }
+        p.points = num::Matrix<double>(n, e.args.size());
+        for (std::size_t c = 0; c < e.args.size(); ++c) {
+            const Value v = closed(*e.args[c].value, Context::constant);
+            for (std::size_t r = 0; r + 1 < n; ++r)
+                p.points(r, c) = num::midpoint(entry(Value::scalar(v.nodes[r]), e.args[c].loc).enclosure);
+            p.points(n - 1, c) = 1;
+        }
+        return p;
+    }
+
+    void automaton_info(const Item& it) {
+        const AutomatonDecl& decl = *it.automaton;
+        AutomatonInfo info;
+        info.name = it.name;
+        info.loc = it.loc;
+        ir::Automaton& a = info.automaton;
+        a.name = it.name;
+        const auto index = [&](const std::string& state) {
+            for (std::size_t i = 0; i < decl.states.size(); ++i)
+                if (decl.states[i].name == state) return i;
+            throw InternalError("an unresolved state");
+        };
+        for (const StateDecl& s : decl.states) {
+            ir::State st;
+            st.name = s.name;
+            st.space = space_of(s.space);
+            if (s.primitive) st.primitive = primitive_of(s, st.space);
+            a.states.push_back(std::move(st));
+            info.state_locs.push_back(s.loc);
+        }
+        for (const ArcDecl& d : decl.arcs) {
+            ir::Arc arc;
+            arc.from = index(d.from);
+            arc.to = index(d.to);
+            arc.label = d.label;
+            arc.op = arc_operator(closed(*d.op, Context::constant), a.states[arc.from].space);
+            if (d.probability) {
+                const Entry p = entry(closed(*d.probability, Context::constant), d.probability->loc);
+                if (!(p.enclosure.lo >= 0 && p.enclosure.hi <= 1))
+                    fail(d.probability->loc, "a probability is a number from 0 to 1");
+                arc.probability = p.exact ? p.exact->to_double() : num::midpoint(p.enclosure);
+            }
+            a.arcs.push_back(std::move(arc));
+            info.arc_locs.push_back(d.loc);
+        }
+        a.initial = decl.initial.empty() ? 0 : index(decl.initial);
+        if (decl.projection) a.projection = closed(*decl.projection, Context::constant).linear->in(0);
+        m_.automata.push_back(std::move(info));
+        automaton_index_[&it] = m_.automata.size() - 1;
     }
 
     NodeId call_shape(const Item& it, const Expr& e) {
@@ -412,6 +579,12 @@ private:
         const Value s = expr(*e.args[0].value);
         Query q;
         q.loc = e.loc;
+        if (s.automaton) {
+            q.kind = Query::Kind::automaton_dimension;
+            q.shape = automaton_index_.at(s.automaton);
+            m_.queries.push_back(q);
+            return Value::scalar(g_.var(static_cast<int>(m_.queries.size() - 1)));
+        }
         q.shape = shape_info(*s.shape);
         const ShapeInfo& info = m_.shapes[q.shape];
         if (b.kind == BuiltinKind::enclose) {
@@ -491,6 +664,7 @@ private:
                       : e.op == Tok::star  ? Op::Mul
                                            : Op::Div;
         const Location la = e.kids[0]->loc, lb = e.kids[1]->loc;
+        if (a.linear || b.linear) return linear_arithmetic(e, a, b);
         const bool pa = a.kind == ValueKind::point, pb = b.kind == ValueKind::point;
         if (!pa && !pb) return Value::scalar(g_.op(op, scalar(a, la), scalar(b, lb)));
         Value r;
@@ -644,6 +818,7 @@ private:
     Diagnostics& d_;
     std::unordered_map<std::string, const Item*> globals_;
     std::unordered_map<const Item*, std::size_t> shape_index_;
+    std::unordered_map<const Item*, std::size_t> automaton_index_;
     std::unordered_map<const Item*, std::optional<Value>> consts_;
     std::unordered_set<const Item*> failed_consts_;
 };

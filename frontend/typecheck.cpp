@@ -42,11 +42,14 @@ public:
 
     void run() {
         for (const Item& it : p_.items)
-            if (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape)
+            if (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape ||
+                it.kind == ItemKind::automaton)
                 globals_[it.name] = &it;
-        // The order lowering reports in: shapes first, then constants, tests and prints.
+        // The order lowering reports in: shapes first, then automata, constants, tests and prints.
         for (const Item& it : p_.items)
             if (it.kind == ItemKind::shape) guarded(&it, [&] { shape_type(it); });
+        for (const Item& it : p_.items)
+            if (it.kind == ItemKind::automaton) guarded(&it, [&] { automaton_type(it); });
         for (const Item& it : p_.items) {
             switch (it.kind) {
             case ItemKind::const_:
@@ -229,6 +232,7 @@ private:
             require_number(expr(*e.kids[1]).type, e.kids[1]->loc);
             return TValue::of(Type::interval());
         case ExprKind::series: return series(e);
+        case ExprKind::matrix: return TValue::of(matrix_type(e));
         case ExprKind::lambda: {
             TValue v = TValue::of(Type{Type::Kind::function});
             v.closure = std::make_shared<const Closure>(Closure{&e, frames_.back().scopes});
@@ -245,9 +249,12 @@ private:
             if (it.kind == ItemKind::const_) return TValue::of(const_type(it, e.loc));
             TValue v;
             v.item = &it;
-            v.type = it.kind == ItemKind::shape ? shape_type(it) : Type{Type::Kind::function};
+            v.type = it.kind == ItemKind::shape       ? shape_type(it)
+                     : it.kind == ItemKind::automaton ? automaton_type(it)
+                                                      : Type{Type::Kind::function};
             return v;
         }
+        if (e.text == "identity") return TValue::of(Type::transform(0));
         if (is_builtin_constant(e.text)) return TValue::of(Type::number());
         if (const Builtin* b = find_builtin(e.text)) {
             TValue v = TValue::of(Type{Type::Kind::function});
@@ -326,8 +333,154 @@ private:
 
     TValue call_builtin(const Builtin& b, const Expr& e) {
         if (b.kind == BuiltinKind::enclose || b.kind == BuiltinKind::dimension) return query(e, b);
+        if (b.kind == BuiltinKind::controls) return TValue::of(controls_type(e));
+        if (b.kind == BuiltinKind::primitive)
+            fail(e.loc,
+                 fmt::format("'{}' draws a state of an automaton: it is written after 'primitive' only",
+                             e.text));
         for (const Arg& a : e.args) require_number(expr(*a.value).type, a.loc);
-        return TValue::of(Type::number());
+        if (b.kind != BuiltinKind::transform) return TValue::of(Type::number());
+        // translate(x, y[, z]), scale(s) or scale(sx, sy[, sz]), rotate(angle), shear(kx, ky).
+        const std::string name = e.text;
+        const int n = static_cast<int>(e.args.size());
+        if (name == "translate") return TValue::of(Type::transform(n));
+        if (name == "scale") {
+            if (n == 1) return TValue::of(Type::transform(0));
+            return TValue::of(Type::transform(n));
+        }
+        if (name == "shear" && n != 2) fail(e.loc, "'shear' takes 2 arguments, kx and ky (a shear of R2)");
+        return TValue::of(Type::transform(2));
+    }
+
+    // controls(P0, ..., Pn-1): points of one dimension, as the columns of a (d + 1) × n matrix.
+    Type controls_type(const Expr& e) {
+        int d = 0;
+        for (const Arg& a : e.args) {
+            const Type p = expr(*a.value).type;
+            if (p.kind != Type::Kind::point)
+                fail(a.loc, fmt::format("a control point is a point, found {}", type_name(p)));
+            if (d && p.size != d)
+                fail(a.loc, fmt::format("control points of {} and {} coordinates", d, p.size));
+            d = p.size;
+        }
+        return Type::matrix(d + 1, static_cast<int>(e.args.size()));
+    }
+
+    // [[a, b], [c, d]]: constant numbers, rows of one length (the parser checked the lengths).
+    Type matrix_type(const Expr& e) {
+        for (const ExprPtr& row : e.kids)
+            for (const ExprPtr& k : row->kids) require_number(expr(*k).type, k->loc);
+        return Type::matrix(static_cast<int>(e.kids.size()), static_cast<int>(e.kids[0]->kids.size()));
+    }
+
+    // ---- automata ----
+    static int coordinates(const SpaceDecl& s) { return s.barycentric ? s.n : s.n + 1; }
+    static std::string space_text(const SpaceDecl& s) {
+        return s.barycentric ? fmt::format("bary({})", s.n) : fmt::format("R{}", s.n);
+    }
+
+    Type automaton_type(const Item& it) {
+        if (auto done = out_.items.find(&it); done != out_.items.end()) return done->second;
+        if (failed_.count(&it)) throw AlreadyReported{};
+        try {
+            check_automaton(it);
+        } catch (...) {
+            failed_.insert(&it);
+            throw;
+        }
+        return out_.items[&it] = Type{Type::Kind::automaton};
+    }
+
+    void check_automaton(const Item& it) {
+        const AutomatonDecl& a = *it.automaton;
+        const auto state = [&](const std::string& name) -> const StateDecl& {
+            for (const StateDecl& s : a.states)
+                if (s.name == name) return s;
+            throw InternalError("an unresolved state");
+        };
+        for (const ArcDecl& arc : a.arcs) {
+            const SpaceDecl &from = state(arc.from).space, &to = state(arc.to).space;
+            const Type op = closed(*arc.op, Context::constant).type;
+            const int rows = coordinates(from), cols = coordinates(to);
+            const std::string arc_text = fmt::format("{} -> {}", arc.from, arc.to);
+            if (op.kind == Type::Kind::transform) {
+                if (from.barycentric || to.barycentric || from.n != to.n)
+                    fail(arc.op->loc,
+                         fmt::format("the arc {} maps {} into {}: a transform maps a space R2 or R3 into "
+                                     "itself; write a matrix of {} rows and {} columns",
+                                     arc_text, space_text(to), space_text(from), rows, cols));
+                if (op.size && op.size != from.n)
+                    fail(arc.op->loc, fmt::format("the arc {} connects states in R{}, its operator is {}",
+                                                  arc_text, from.n, type_name(op)));
+            } else if (op.kind == Type::Kind::matrix) {
+                if (op.rows != rows || op.cols != cols)
+                    fail(arc.op->loc,
+                         fmt::format(
+                             "the arc {} maps {} into {}, so its matrix has {} rows and {} columns; this one "
+                             "is {}×{}",
+                             arc_text, space_text(to), space_text(from), rows, cols, op.rows, op.cols));
+            } else {
+                fail(arc.op->loc,
+                     fmt::format("an arc's operator is a matrix or a transform, found {}", type_name(op)));
+            }
+            if (arc.probability)
+                require_number(closed(*arc.probability, Context::constant).type, arc.probability->loc);
+        }
+        const StateDecl& initial = a.initial.empty() ? a.states.front() : state(a.initial);
+        if (a.projection) {
+            const Type p = closed(*a.projection, Context::constant).type;
+            if (!initial.space.barycentric)
+                fail(a.projection->loc,
+                     fmt::format("the initial state '{}' is in {}: only a barycentric initial "
+                                 "state is projected",
+                                 initial.name, space_text(initial.space)));
+            if (p.kind != Type::Kind::matrix || p.cols != initial.space.n || (p.rows != 3 && p.rows != 4))
+                fail(a.projection->loc,
+                     fmt::format("the projection of bary({}) is controls(P1, ..., P{}) with points "
+                                 "of R2 or R3, found {}",
+                                 initial.space.n, initial.space.n, type_name(p)));
+        } else if (initial.space.barycentric) {
+            fail(a.initial.empty() ? initial.loc : a.initial_loc,
+                 fmt::format("the initial state '{}' is in bary({}): give its control points, as in "
+                             "project = controls(P1, ..., P{});",
+                             initial.name, initial.space.n, initial.space.n));
+        }
+        for (const StateDecl& s : a.states)
+            if (s.primitive) primitive_type(s);
+    }
+
+    // point(p), segment(p, q), polyline(p, ...), polygon(p, ...) of points in a euclidean state's space;
+    // polyline() and polygon() of a barycentric state join its vertices; or a shape of its dimension.
+    void primitive_type(const StateDecl& s) {
+        const Expr& e = *s.primitive;
+        if (e.kind == ExprKind::name) {
+            const Type t = closed(e, Context::constant).type;
+            if (t.kind != Type::Kind::shape || s.space.barycentric || t.size != s.space.n)
+                fail(e.loc, fmt::format("a primitive is a shape of the state's space {} or a point, segment, "
+                                        "polyline or polygon; found {}",
+                                        space_text(s.space), type_name(t)));
+            return;
+        }
+        const Builtin* b = e.kind == ExprKind::call ? find_builtin(e.text) : nullptr;
+        if (!b || b->kind != BuiltinKind::primitive)
+            fail(e.loc,
+                 "a primitive is point(p), segment(p, q), polyline(p, ...), polygon(p, ...) or a shape");
+        if (s.space.barycentric) {
+            if (!e.args.empty() || (e.text != "polyline" && e.text != "polygon"))
+                fail(e.loc,
+                     fmt::format("a state in bary({}) draws polyline() or polygon(): its vertices joined",
+                                 s.space.n));
+            return;
+        }
+        if (e.args.empty()) fail(e.loc, fmt::format("'{}' needs points of R{}", e.text, s.space.n));
+        for (const Arg& a : e.args) {
+            const Type p = closed(*a.value, Context::constant).type;
+            if (p.kind != Type::Kind::point || p.size != s.space.n)
+                fail(a.loc, fmt::format("a point of the state's space R{} is expected, found {}", s.space.n,
+                                        p.kind == Type::Kind::point
+                                            ? fmt::format("a point of {} coordinates", p.size)
+                                            : type_name(p)));
+        }
     }
 
     TValue query(const Expr& e, const Builtin& b) {
@@ -336,6 +489,12 @@ private:
                  fmt::format("'{}' runs a computation on a shape; it is available in tests and print only",
                              e.text));
         const TValue s = expr(*e.args[0].value);
+        if (b.kind == BuiltinKind::dimension && s.type.kind == Type::Kind::automaton) {
+            if (e.args.size() > 1)
+                fail(e.args[1].loc,
+                     "the dimension of an automaton is computed from its maps: it takes no levels");
+            return TValue::of(Type::number());
+        }
         if (s.type.kind != Type::Kind::shape)
             fail(e.args[0].loc, fmt::format("'{}' needs a shape as its first argument", e.text));
         if (b.kind == BuiltinKind::enclose) {
@@ -480,6 +639,14 @@ std::string print_types(const Program& program, const TypedProgram& typed, std::
             out += fmt::format("test \"{}\" : {} expectations\n", it.name, it.expects.size());
             break;
         case ItemKind::print: out += fmt::format("print : {}\n", type_of(it.body.get())); break;
+        case ItemKind::automaton: {
+            const AutomatonDecl& a = *it.automaton;
+            out += fmt::format("{} {} : automaton\n", a.graph_directed ? "cifs" : "ifs", it.name);
+            for (const ArcDecl& arc : a.arcs)
+                out += fmt::format("  {} -> {}{} : {}\n", arc.from, arc.to,
+                                   arc.label.empty() ? "" : " " + arc.label, type_of(arc.op.get()));
+            break;
+        }
         case ItemKind::import: break;
         }
     }
