@@ -32,9 +32,10 @@ std::string arc_title(const Automaton& a, std::size_t i) {
     return fmt::format("arc {} ({} -> {})", arc_name(a, i), a.states[arc.from].name, a.states[arc.to].name);
 }
 
-// Spectral-radius bracket of a non-negative interval matrix: Collatz–Wielandt quotients of an
-// approximate Perron vector x > 0 (for any x > 0, min (Mx)_i / x_i <= rho(M) <= max (Mx)_i / x_i).
-Interval collatz_wielandt(const Matrix<Interval>& m) {
+} // namespace
+
+// For any x > 0 and M >= 0: min (Mx)_i / x_i <= rho(M) <= max (Mx)_i / x_i.
+Interval spectral_radius_bracket(const Matrix<Interval>& m) {
     const std::size_t n = m.rows();
     if (n == 0) return {0.0, 0.0};
     // Power iteration on M + I (aperiodic, same Perron vector) with the midpoints, round to nearest.
@@ -67,6 +68,8 @@ Interval collatz_wielandt(const Matrix<Interval>& m) {
     }
     return {std::max(lo, 0.0), hi};
 }
+
+namespace {
 
 // Largest eigenvalue modulus of a double matrix, estimated from ||P^(2^k)||^(1/2^k).
 double spectral_radius_estimate(Matrix<double> p) {
@@ -299,7 +302,7 @@ ContractivityResult prove_contractive(const Automaton& a, const ContractivityOpt
             Matrix<Interval> block(members.size(), members.size());
             for (std::size_t i = 0; i < members.size(); ++i)
                 for (std::size_t j = 0; j < members.size(); ++j) block(i, j) = m(members[i], members[j]);
-            rho = std::max(rho, collatz_wielandt(block).hi);
+            rho = std::max(rho, spectral_radius_bracket(block).hi);
         }
         best_bound = std::min(best_bound, rho);
         if (rho < 1.0) {

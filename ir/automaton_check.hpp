@@ -85,6 +85,10 @@ std::vector<bool> reachable_states(const Automaton& a);
 // component index per state (-1 where not kept); components are numbered in reverse topological order.
 std::vector<int> strongly_connected_components(const Automaton& a, const std::vector<bool>& keep,
                                                int* count = nullptr);
+// Bracket of the spectral radius of a non-negative interval matrix (entries >= 0): the
+// Collatz–Wielandt quotients min (Mx)_i / x_i and max (Mx)_i / x_i of an approximate Perron vector
+// x > 0, outward rounded. The upper end is always valid; the lower end is tight for irreducible M.
+num::Interval spectral_radius_bracket(const num::Matrix<num::Interval>& m);
 // Upper bound of the spectral 2-norm of an interval matrix (needs no particular rounding mode).
 double norm2_upper(const num::Matrix<num::Interval>& m);
 
