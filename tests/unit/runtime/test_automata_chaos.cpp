@@ -1,0 +1,143 @@
+// The chaos game: reproducible streams, probabilities, graph-directed automata, threads.
+#include "runtime/automata/chaos.hpp"
+#include "runtime/automata/points.hpp"
+#include "runtime/automata/tree.hpp"
+#include "tests/unit/automata_examples.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+
+using namespace frac;
+using namespace frac::test;
+
+TEST_CASE("xoshiro256** streams are fixed by seed and stream", "[automata][chaos]") {
+    rt::Xoshiro256 a(42), b(42), c(43), d(42, 1);
+    std::uint64_t first = 0;
+    for (int i = 0; i < 1000; ++i) {
+        const std::uint64_t x = a();
+        CHECK(x == b());
+        if (i == 0) first = x;
+    }
+    CHECK(first != c());
+    CHECK(first != d());
+    // Thresholds split [0, 2^64) in proportion.
+    const auto t = rt::draw_thresholds({1, 1, 2});
+    CHECK(t[0] == (std::uint64_t{1} << 62) - 1);
+    CHECK(t[1] == (std::uint64_t{1} << 63) - 1);
+    CHECK(t[2] == UINT64_MAX);
+}
+
+TEST_CASE("probabilities: the model's, else from determinants with a floor", "[automata][chaos]") {
+    const auto p = rt::chaos_probabilities(fern());
+    const double dets[] = {0.0, 0.85 * 0.85 + 0.04 * 0.04, 0.2 * 0.22 + 0.26 * 0.23,
+                           0.15 * 0.24 + 0.28 * 0.26};
+    const double floor = 0.01 * dets[1];
+    const double total = floor + dets[1] + dets[2] + dets[3];
+    CHECK(p[0] == Approx(floor / total).epsilon(1e-12));
+    CHECK(p[1] == Approx(dets[1] / total).epsilon(1e-12));
+    CHECK(p[3] == Approx(dets[3] / total).epsilon(1e-12));
+    ir::Automaton given = sierpinski();
+    given.arcs[0].probability = 2;
+    given.arcs[1].probability = 1;
+    given.arcs[2].probability = 1;
+    CHECK(rt::chaos_probabilities(given) == std::vector<double>{0.5, 0.25, 0.25});
+    given.arcs[0].probability = -1;
+    CHECK_THROWS_WITH(rt::chaos_probabilities(given), Catch::Contains("probability -1"));
+}
+
+TEST_CASE("chaos-game points lie on the Sierpinski triangle and miss its holes", "[automata][chaos]") {
+    std::uint64_t n = 0;
+    rt::chaos_points(sierpinski(), 20000, 100, 7, [&](const std::vector<double>& p) {
+        ++n;
+        REQUIRE(p.size() == 2);
+        CHECK(p[1] >= -1e-12);
+        CHECK(p[1] <= 2 * p[0] + 1e-12);
+        CHECK(p[1] <= 2 * (1 - p[0]) + 1e-12);
+        // The central hole: below y = 1/2, between the lines through (1/2, 0).
+        CHECK_FALSE((p[1] < 0.5 - 1e-9 && p[1] > 2 * std::abs(p[0] - 0.5) + 1e-9));
+    });
+    CHECK(n == 20000);
+    rt::ChaosOptions o;
+    o.points = 200000;
+    o.width = 64;
+    o.box = std::array<double, 4>{0, 1, 0, 1};
+    const rt::Density d = rt::chaos_game(sierpinski(), o);
+    CHECK(d.height == 64);
+    CHECK(d.outside == 0);
+    CHECK(d.recorded == 200000);
+    CHECK(d.count(32, 19) == 0); // (0.5, 0.3): in the hole
+    CHECK(d.count(2, 1) > 0);    // near the corner (0, 0)
+    CHECK(d.count(60, 60) == 0); // outside the triangle
+}
+
+TEST_CASE("the same seed and thread count give the same density", "[automata][chaos]") {
+    rt::ChaosOptions o;
+    o.points = 100000;
+    o.width = 128;
+    o.seed = 11;
+    const rt::Density a = rt::chaos_game(fern(), o), b = rt::chaos_game(fern(), o);
+    CHECK(a.counts == b.counts);
+    CHECK(a.x0 == b.x0);
+    o.threads = 2;
+    const rt::Density c = rt::chaos_game(fern(), o), e = rt::chaos_game(fern(), o);
+    CHECK(c.counts == e.counts);
+    CHECK(c.recorded + c.outside == 100000);
+    CHECK(c.counts != a.counts); // other streams
+    o.seed = 12;
+    o.threads = 1;
+    CHECK(rt::chaos_game(fern(), o).counts != a.counts);
+    // The default box holds the fern (about [-2.2, 2.7] x [0, 10]).
+    CHECK(a.x0 < -2.1);
+    CHECK(a.x1 > 2.6);
+    CHECK(a.y1 > 9.9);
+    CHECK(a.outside < 100);
+}
+
+TEST_CASE("graph-directed chaos: a projected B-spline through a transient initial state",
+          "[automata][chaos]") {
+    // Every point lies on the curve: near one of the tree's leaf points at depth 12 (4096 of them).
+    const ir::Automaton q = bspline(2, {{0, 0}, {1, 2}, {3, 2}, {4, 0}});
+    std::vector<std::array<double, 2>> curve;
+    const auto pb = rt::attractor_point(q, 1);
+    rt::walk_tree(q, {12, false}, [&](const rt::TreeNode& node) {
+        if (!node.leaf) return;
+        double x = 0, y = 0;
+        for (std::size_t c = 0; c < 3; ++c) x += (*node.op)(0, c) * pb[c], y += (*node.op)(1, c) * pb[c];
+        curve.push_back({x, y});
+    });
+    REQUIRE(curve.size() == 4096);
+    double worst = 0;
+    double xmin = 10, xmax = -10;
+    rt::chaos_points(q, 2000, 50, 3, [&](const std::vector<double>& p) {
+        double best = 1e9;
+        for (const auto& c : curve) best = std::min(best, std::hypot(p[0] - c[0], p[1] - c[1]));
+        worst = std::max(worst, best);
+        xmin = std::min(xmin, p[0]), xmax = std::max(xmax, p[0]);
+    });
+    CHECK(worst < 5e-3);
+    // Both segments are visited: the curve runs from (0.5, 1) to (3.5, 1).
+    CHECK(xmin < 0.7);
+    CHECK(xmax > 3.3);
+}
+
+TEST_CASE("chaos game errors and the density picture", "[automata][chaos]") {
+    ir::Automaton dead = golden();
+    dead.arcs.pop_back();
+    CHECK_THROWS_WITH(rt::chaos_game(dead), Catch::Contains("state b has no transitions"));
+    rt::ChaosOptions o;
+    o.threads = 0;
+    CHECK_THROWS_WITH(rt::chaos_game(sierpinski(), o), Catch::Contains("threads 0"));
+    o.threads = 1;
+    o.points = 50000;
+    o.width = 100;
+    const rt::Density d = rt::chaos_game(cantor(), o);
+    CHECK(d.height >= 1);
+    const rt::Image img = rt::density_image(d);
+    CHECK(img.width == 100);
+    const auto path = std::filesystem::temp_directory_path() / "frac_chaos_cantor.png";
+    rt::write_density_png(d, path.string());
+    CHECK(std::filesystem::file_size(path) > 50);
+    std::filesystem::remove(path);
+}
