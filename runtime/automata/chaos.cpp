@@ -41,15 +41,7 @@ struct Prepared {
 
 Prepared prepare(const ir::Automaton& a, double floor) {
     const std::size_t ns = a.states.size();
-    if (a.initial >= ns) throw std::invalid_argument("the initial state does not exist");
-    for (std::size_t i = 0; i < a.arcs.size(); ++i) {
-        const ir::Arc& arc = a.arcs[i];
-        if (arc.from >= ns || arc.to >= ns ||
-            arc.op.rows() != static_cast<std::size_t>(a.states[arc.from].space.coordinates()) ||
-            arc.op.cols() != static_cast<std::size_t>(a.states[arc.to].space.coordinates()))
-            throw std::invalid_argument(
-                fmt::format("arc {} does not fit the states it connects", ir::arc_name(a, i)));
-    }
+    require_well_formed(a);
     const std::vector<bool> live = ir::reachable_states(a);
     Prepared p;
     p.initial = a.initial;

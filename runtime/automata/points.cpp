@@ -69,6 +69,19 @@ std::optional<std::vector<double>> point_along(const ir::Automaton& a, const std
 
 } // namespace
 
+void require_well_formed(const ir::Automaton& a) {
+    const std::size_t n = a.states.size();
+    if (a.initial >= n) throw std::invalid_argument("the initial state does not exist");
+    for (std::size_t i = 0; i < a.arcs.size(); ++i) {
+        const ir::Arc& arc = a.arcs[i];
+        if (arc.from >= n || arc.to >= n ||
+            arc.op.rows() != static_cast<std::size_t>(a.states[arc.from].space.coordinates()) ||
+            arc.op.cols() != static_cast<std::size_t>(a.states[arc.to].space.coordinates()))
+            throw std::invalid_argument(
+                fmt::format("arc {} does not fit the states it connects", ir::arc_name(a, i)));
+    }
+}
+
 std::vector<double> attractor_point(const ir::Automaton& a, std::size_t state) {
     std::vector<std::size_t> path;                            // the first arcs taken
     std::vector<std::size_t> seen(a.states.size(), SIZE_MAX); // position of each state on the path

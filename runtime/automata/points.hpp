@@ -11,6 +11,10 @@
 
 namespace frac::rt {
 
+// Throws std::invalid_argument unless the initial state exists and every arc connects existing
+// states with an operator of their sizes (what evaluation needs; ir::check_automaton says more).
+void require_well_formed(const ir::Automaton& a);
+
 // The homogeneous column (in the space of `state`) of phi(0^infinity): follow the first arc of each
 // state until a state repeats, take the fixed point of the cycle's composite operator (exactly when
 // its operators are exact) and map it back along the path. Throws std::invalid_argument when a state

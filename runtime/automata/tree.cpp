@@ -77,9 +77,9 @@ void leaf_shapes(const ir::Automaton& a, int depth, Shape&& shape) {
                 for (std::size_t r = 0; r < p.points.rows(); ++r) col[r] = p.points(r, c);
                 columns[s].push_back(std::move(col));
             }
-        } else {
+        } else if (!a.arcs_from(s).empty()) {
             columns[s].push_back(attractor_point(a, s));
-        }
+        } // a state without arcs and without a primitive draws nothing
     }
     std::vector<std::array<double, 2>> pts;
     std::vector<double> image;
@@ -195,17 +195,9 @@ TreeStats walk_tree(const ir::Automaton& a, const TreeOptions& options,
     if (options.depth < 0 || options.depth > 64)
         throw std::invalid_argument(fmt::format("tree depth {} is outside [0, 64]", options.depth));
     const std::size_t n = a.states.size();
-    if (a.initial >= n) throw std::invalid_argument("the initial state does not exist");
+    require_well_formed(a);
     std::vector<std::vector<std::size_t>> out(n);
-    for (std::size_t i = 0; i < a.arcs.size(); ++i) {
-        const ir::Arc& arc = a.arcs[i];
-        if (arc.from >= n || arc.to >= n ||
-            arc.op.rows() != static_cast<std::size_t>(a.states[arc.from].space.coordinates()) ||
-            arc.op.cols() != static_cast<std::size_t>(a.states[arc.to].space.coordinates()))
-            throw std::invalid_argument(
-                fmt::format("arc {} does not fit the states it connects", ir::arc_name(a, i)));
-        out[arc.from].push_back(i);
-    }
+    for (std::size_t i = 0; i < a.arcs.size(); ++i) out[a.arcs[i].from].push_back(i);
     const std::size_t levels = static_cast<std::size_t>(options.depth) + 1;
     std::vector<num::Matrix<double>> op(levels);
     std::vector<num::Matrix<num::Interval>> enc(options.intervals ? levels : 0);
