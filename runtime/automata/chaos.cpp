@@ -104,44 +104,80 @@ Prepared prepare(const ir::Automaton& a, double floor) {
 }
 
 // `steps` steps of the game; after the first `transient`, record(x, y) for the initial state's point.
+// y = M x for an N x N matrix; affine maps skip the last row (0 ... 0 1) and add the last column
+// without multiplying it by the homogeneous 1 (the same bits, fewer operations).
+template <std::size_t N, bool Affine>
+inline std::array<double, N> apply(const double* m, const std::array<double, N>& x) {
+    std::array<double, N> y;
+    constexpr std::size_t rows = Affine ? N - 1 : N, cols = Affine ? N - 1 : N;
+    for (std::size_t r = 0; r < rows; ++r) {
+        double s = m[r * N] * x[0];
+        for (std::size_t c = 1; c < cols; ++c) s += m[r * N + c] * x[c];
+        if constexpr (Affine) s += m[r * N + N - 1];
+        y[r] = s;
+    }
+    if constexpr (Affine) y[N - 1] = 1.0;
+    return y;
+}
+
+// `transient` steps, then `points` steps each followed by record(x, y) of the initial state's point.
+// The generator and the pointers are copied to locals so that the compiler keeps them in registers
+// (the density's counter increments could otherwise alias them).
 template <std::size_t N, bool Affine, bool Direct, typename Record>
-void run(const Prepared& p, Xoshiro256& rng, std::uint64_t transient, std::uint64_t points, Record&& record) {
-    std::vector<std::array<double, N>> x(p.start.size() / N);
-    for (std::size_t s = 0; s < x.size(); ++s)
-        for (std::size_t c = 0; c < N; ++c) x[s][c] = p.start[s * N + c];
-    const std::size_t* order = p.order.data();
-    const std::size_t live = p.order.size();
-    constexpr std::size_t rows = Affine ? N - 1 : N;
-    auto step = [&] {
-        for (std::size_t k = 0; k < live; ++k) {
-            const std::size_t q = order[k];
-            const std::uint64_t u = rng();
-            std::size_t i = p.first[q];
-            while (u > p.thresholds[i]) ++i;
-            const double* m = &p.m[i * N * N];
-            const std::array<double, N>& from = x[p.to[i]];
-            std::array<double, N> y;
-            for (std::size_t r = 0; r < rows; ++r) {
-                double s = 0;
-                for (std::size_t c = 0; c < N; ++c) s += m[r * N + c] * from[c];
-                y[r] = s;
-            }
-            if constexpr (Affine) y[N - 1] = 1.0;
-            x[q] = y;
-        }
-    };
-    for (std::uint64_t t = 0; t < transient; ++t) step();
-    const std::array<double, N>& point = x[p.initial];
-    for (std::uint64_t t = 0; t < points; ++t) {
-        step();
+[[gnu::flatten]] void run(const Prepared& p, Xoshiro256& shared_rng, std::uint64_t transient, std::uint64_t points,
+         Record&& record) {
+    Xoshiro256 rng = shared_rng;
+    const std::uint64_t* thresholds = p.thresholds.data();
+    const std::size_t* to = p.to.data();
+    const double* mats = p.m.data();
+    const std::array<double, 2 * N> out = [&] {
+        std::array<double, 2 * N> o{};
+        for (std::size_t c = 0; c < N; ++c) o[c] = p.out[0][c], o[N + c] = p.out[1][c];
+        return o;
+    }();
+    const bool plane = p.dims >= 2;
+    auto emit = [&](const std::array<double, N>& x) {
         if constexpr (Direct) {
-            record(point[0], p.dims >= 2 ? point[1] : 0.0);
+            record(x[0], plane ? x[1] : 0.0);
         } else {
             double px = 0, py = 0;
-            for (std::size_t c = 0; c < N; ++c) px += p.out[0][c] * point[c], py += p.out[1][c] * point[c];
+            for (std::size_t c = 0; c < N; ++c) px += out[c] * x[c], py += out[N + c] * x[c];
             record(px, py);
         }
+    };
+    auto draw = [&](std::size_t first) {
+        const std::uint64_t u = rng();
+        std::size_t i = first;
+        while (u > thresholds[i]) ++i;
+        return i;
+    };
+    if (p.order.size() == 1) {
+        // One live state (an IFS): its point stays in registers.
+        const std::size_t first = p.first[p.initial];
+        std::array<double, N> x;
+        for (std::size_t c = 0; c < N; ++c) x[c] = p.start[p.initial * N + c];
+        for (std::uint64_t t = 0; t < transient; ++t) x = apply<N, Affine>(mats + draw(first) * N * N, x);
+        for (std::uint64_t t = 0; t < points; ++t) {
+            x = apply<N, Affine>(mats + draw(first) * N * N, x);
+            emit(x);
+        }
+    } else {
+        std::vector<std::array<double, N>> x(p.start.size() / N);
+        for (std::size_t s = 0; s < x.size(); ++s)
+            for (std::size_t c = 0; c < N; ++c) x[s][c] = p.start[s * N + c];
+        auto step = [&] {
+            for (std::size_t q : p.order) {
+                const std::size_t i = draw(p.first[q]);
+                x[q] = apply<N, Affine>(mats + i * N * N, x[to[i]]);
+            }
+        };
+        for (std::uint64_t t = 0; t < transient; ++t) step();
+        for (std::uint64_t t = 0; t < points; ++t) {
+            step();
+            emit(x[p.initial]);
+        }
     }
+    shared_rng = rng;
 }
 
 template <typename Record>
@@ -282,10 +318,12 @@ Density chaos_game(const ir::Automaton& a, const ChaosOptions& o) {
         Xoshiro256 rng(o.seed, t);
         const std::uint64_t share = o.points / threads + (t < o.points % threads ? 1 : 0);
         const std::size_t width = static_cast<std::size_t>(d.width);
+        std::uint64_t* cells_of = grid.data();
+        const double x0 = d.x0, y0 = d.y0;
         dispatch(p, rng, o.transient, share, [&](double x, double y) {
-            const double fx = (x - d.x0) * sx, fy = (y - d.y0) * sy;
+            const double fx = (x - x0) * sx, fy = (y - y0) * sy;
             if (fx >= 0 && fx < w && fy >= 0 && fy < h)
-                ++grid[static_cast<std::size_t>(fy) * width + static_cast<std::size_t>(fx)];
+                ++cells_of[static_cast<std::size_t>(fy) * width + static_cast<std::size_t>(fx)];
             else
                 ++out;
         });
