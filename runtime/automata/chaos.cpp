@@ -124,8 +124,8 @@ inline std::array<double, N> apply(const double* m, const std::array<double, N>&
 // The generator and the pointers are copied to locals so that the compiler keeps them in registers
 // (the density's counter increments could otherwise alias them).
 template <std::size_t N, bool Affine, bool Direct, typename Record>
-[[gnu::flatten]] void run(const Prepared& p, Xoshiro256& shared_rng, std::uint64_t transient, std::uint64_t points,
-         Record&& record) {
+[[gnu::flatten]] void run(const Prepared& p, Xoshiro256& shared_rng, std::uint64_t transient,
+                          std::uint64_t points, Record&& record) {
     Xoshiro256 rng = shared_rng;
     const std::uint64_t* thresholds = p.thresholds.data();
     const std::size_t* to = p.to.data();
@@ -342,6 +342,66 @@ Density chaos_game(const ir::Automaton& a, const ChaosOptions& o) {
     for (std::uint64_t v : outside) d.outside += v;
     d.recorded = o.points - d.outside;
     return d;
+}
+
+Cover density_cover(const Density& d, bool keep_cells) {
+    int depth = 0;
+    while (depth <= 12 && (1 << depth) < d.width) ++depth;
+    if (depth > 12 || d.width != (1 << depth) || d.height != d.width)
+        throw std::invalid_argument(fmt::format(
+            "a density cover needs a 2^k x 2^k grid with k <= 12, not {} x {}", d.width, d.height));
+    Cover c;
+    c.root = {num::Interval(d.x0, d.x1), num::Interval(d.y0, d.y1)};
+    c.depth = depth;
+    c.split = 2;
+    c.levels.assign(static_cast<std::size_t>(depth) + 1, LevelCounts{});
+    // Occupancy per level, finest first, coarser ones by OR over 2 x 2 children.
+    std::vector<std::vector<std::uint8_t>> occupied(static_cast<std::size_t>(depth) + 1);
+    occupied[static_cast<std::size_t>(depth)].resize(d.counts.size());
+    for (std::size_t i = 0; i < d.counts.size(); ++i)
+        occupied[static_cast<std::size_t>(depth)][i] = d.counts[i] > 0;
+    for (int k = depth - 1; k >= 0; --k) {
+        const std::size_t n = std::size_t{1} << k;
+        auto& level = occupied[static_cast<std::size_t>(k)];
+        const auto& finer = occupied[static_cast<std::size_t>(k) + 1];
+        level.assign(n * n, 0);
+        for (std::size_t y = 0; y < 2 * n; ++y)
+            for (std::size_t x = 0; x < 2 * n; ++x) level[(y / 2) * n + x / 2] |= finer[y * 2 * n + x];
+    }
+    for (int k = 0; k <= depth; ++k) {
+        const std::size_t n = std::size_t{1} << k;
+        LevelCounts& lc = c.levels[static_cast<std::size_t>(k)];
+        for (std::size_t y = 0; y < n; ++y)
+            for (std::size_t x = 0; x < n; ++x) {
+                if (k > 0 && !occupied[static_cast<std::size_t>(k) - 1][(y / 2) * (n / 2) + x / 2]) continue;
+                ++lc.evaluated;
+                const bool full = occupied[static_cast<std::size_t>(k)][y * n + x];
+                CellClass cls = CellClass::outside;
+                if (full) {
+                    ++lc.undecided;
+                    cls = k < depth ? CellClass::subdivided : CellClass::boundary;
+                } else {
+                    ++lc.outside;
+                }
+                if (keep_cells)
+                    c.cells.push_back({static_cast<std::uint8_t>(k), cls, static_cast<std::uint32_t>(x),
+                                       static_cast<std::uint32_t>(y), 0});
+            }
+        c.evaluated += lc.evaluated;
+        c.outside += lc.outside;
+        if (k < depth)
+            c.subdivided += lc.undecided;
+        else
+            c.boundary = lc.undecided;
+    }
+    return c;
+}
+
+Cover chaos_cover(const ir::Automaton& a, int depth, ChaosOptions options, bool keep_cells) {
+    if (depth < 0 || depth > 12)
+        throw std::invalid_argument(fmt::format("cover depth {} is outside [0, 12]", depth));
+    options.width = options.height = 1 << depth;
+    return density_cover(chaos_game(a, options), keep_cells);
 }
 
 Image density_image(const Density& d) {

@@ -15,6 +15,7 @@
 #pragma once
 
 #include "ir/automaton.hpp"
+#include "runtime/cover.hpp"
 #include "runtime/picture.hpp"
 
 #include <array>
@@ -104,6 +105,14 @@ Density chaos_game(const ir::Automaton& a, const ChaosOptions& options = {});
 void chaos_points(const ir::Automaton& a, std::uint64_t points, std::uint64_t transient, std::uint64_t seed,
                   const std::function<void(const std::vector<double>&)>& visit,
                   double degenerate_floor = 0.01);
+
+// The density as a cover (runtime/cover.hpp), so that pictures and box counting (runtime/dimension.hpp)
+// work on chaos-game attractors: the grid must be 2^depth x 2^depth (depth in [0, 12]); a cell of
+// level k is occupied when a point fell in it, occupied cells are subdivided (boundary at the last
+// level), empty ones outside. With keep_cells, the cells are listed as the cover's order requires.
+Cover density_cover(const Density& d, bool keep_cells = true);
+// chaos_game on a 2^depth grid (options.width and height are replaced), as a cover.
+Cover chaos_cover(const ir::Automaton& a, int depth, ChaosOptions options = {}, bool keep_cells = true);
 
 // Grey levels, log-scaled from white (no point) to black (the densest cell), y up.
 Image density_image(const Density& d);

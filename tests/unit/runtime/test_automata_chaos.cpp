@@ -2,6 +2,7 @@
 #include "runtime/automata/chaos.hpp"
 #include "runtime/automata/points.hpp"
 #include "runtime/automata/tree.hpp"
+#include "runtime/dimension.hpp"
 #include "tests/unit/automata_examples.hpp"
 
 #include <catch2/catch.hpp>
@@ -140,4 +141,21 @@ TEST_CASE("chaos game errors and the density picture", "[automata][chaos]") {
     rt::write_density_png(d, path.string());
     CHECK(std::filesystem::file_size(path) > 50);
     std::filesystem::remove(path);
+}
+
+TEST_CASE("chaos-game covers: box counting agrees with the similarity dimension", "[automata][chaos]") {
+    rt::ChaosOptions o;
+    o.points = 2'000'000;
+    o.seed = 9;
+    const rt::Cover c = rt::chaos_cover(sierpinski(), 9, o);
+    CHECK(c.depth == 9);
+    CHECK(c.levels[0].undecided == 1);
+    CHECK(c.cells.size() == c.evaluated);
+    const rt::DimensionEstimate e = rt::box_counting(c, 3, 8);
+    CHECK(std::abs(e.dimension - std::log(3.0) / std::log(2.0)) < 0.05);
+    // The Koch curve and the Cantor set too.
+    const rt::DimensionEstimate k = rt::box_counting(rt::chaos_cover(koch(), 9, o, false), 3, 8);
+    CHECK(std::abs(k.dimension - std::log(4.0) / std::log(3.0)) < 0.05);
+    o.width = 100;
+    CHECK_THROWS_WITH(rt::density_cover(rt::chaos_game(cantor(), o)), Catch::Contains("2^k x 2^k"));
 }
