@@ -264,6 +264,7 @@ ContractivityResult prove_contractive(const Automaton& a, const ContractivityOpt
     std::vector<double> paths(n, 1.0);
     std::size_t products = 0;
     double best_bound = num::inf;
+    int tried = 0; // the longest length whose paths were all bounded
     for (int length = 1; length <= options.max_length; ++length) {
         std::vector<double> more(n, 0.0);
         double total = 0;
@@ -305,6 +306,7 @@ ContractivityResult prove_contractive(const Automaton& a, const ContractivityOpt
             rho = std::max(rho, spectral_radius_bracket(block).hi);
         }
         best_bound = std::min(best_bound, rho);
+        tried = length;
         if (rho < 1.0) {
             result.proven = true;
             result.bound = rho;
@@ -328,10 +330,11 @@ ContractivityResult prove_contractive(const Automaton& a, const ContractivityOpt
     std::vector<std::size_t> path;
     std::vector<bool> on_path(n, false);
     double worst = -1;
-    std::size_t cycles = 0;
+    std::size_t cycles = 0, steps = 0;
     std::function<void(std::size_t, std::size_t, const Matrix<double>&)> search =
         [&](std::size_t start, std::size_t s, const Matrix<double>& product) {
-            if (cycles > 20000) return;
+            // Bounded search: enough to name a cycle, never exponential in the automaton's size.
+            if (cycles > 20000 || ++steps > 400000) return;
             for (std::size_t i : out[s]) {
                 const std::size_t t = a.arcs[i].to;
                 if (t < start || (t != start && on_path[t])) continue;
@@ -370,9 +373,10 @@ ContractivityResult prove_contractive(const Automaton& a, const ContractivityOpt
         result.message = fmt::format("could not prove contraction with paths up to length {} (best bound "
                                      "{:.6g}); the slowest cycle is {}, "
                                      "contracting by about {:.6g} per transition",
-                                     options.max_length, best_bound, path_text(a, result.cycle), worst);
+                                     tried, best_bound, path_text(a, result.cycle), worst);
     } else {
-        result.message = fmt::format("could not prove contraction (best bound {:.6g})", best_bound);
+        result.message = fmt::format(
+            "could not prove contraction with paths up to length {} (best bound {:.6g})", tried, best_bound);
     }
     return result;
 }
@@ -422,6 +426,18 @@ std::vector<AutomatonProblem> check_automaton(const Automaton& a, const Contract
                     "{}: the operator maps {} into {}, so it needs {} rows and {} columns, not {} x {}",
                     arc_title(a, i), space_name(to), space_name(from), rows, cols, arc.op.rows(),
                     arc.op.cols())));
+            arcs_ok = false;
+            continue;
+        }
+        bool finite = true;
+        for (std::size_t r = 0; r < rows; ++r)
+            for (std::size_t c = 0; c < cols; ++c)
+                finite = finite && std::isfinite(arc.op.enclosure(r, c).lo) &&
+                         std::isfinite(arc.op.enclosure(r, c).hi);
+        if (!finite) {
+            problems.push_back(
+                problem(K::size, arc.from, i,
+                        fmt::format("{}: the operator has an entry that is not finite", arc_title(a, i))));
             arcs_ok = false;
             continue;
         }

@@ -179,3 +179,14 @@ TEST_CASE("unreachable states are warnings, dead ends and partial probabilities 
     REQUIRE(errs.size() == 1);
     CHECK(errs[0].kind == AutomatonProblem::Kind::probability);
 }
+
+TEST_CASE("non-finite operator entries are located errors", "[automaton_check]") {
+    ir::Automaton a = koch();
+    Matrix<Interval> m = a.arcs[2].op.enclosure;
+    m(0, 1) = Interval(-num::inf, 1.0);
+    a.arcs[2] = arc(0, 0, m, "f2");
+    const auto errs = errors(ir::check_automaton(a));
+    REQUIRE(errs.size() == 1);
+    CHECK(errs[0].arc == std::optional<std::size_t>(2));
+    CHECK(mentions(errs[0].message, "not finite"));
+}
