@@ -198,4 +198,16 @@ inline ir::Automaton bspline(int degree, const std::vector<std::pair<long, long>
     return a;
 }
 
+// One quadratic segment as Guérin's projected IFS P A: the initial state is bary(3) with the two
+// subdivision matrices, drawn through the control points.
+inline ir::Automaton projected_quadratic(const std::vector<std::pair<long, long>>& points) {
+    ir::Automaton a = bspline(2, points);
+    a.arcs.erase(a.arcs.begin()); // the one segment arc of state a
+    for (auto& arc : a.arcs) arc.from = arc.to = 0;
+    a.states.erase(a.states.begin());
+    a.initial = 0;
+    a.projection = ir::Operator::from_exact(control_points(points, 0, 3));
+    return a;
+}
+
 } // namespace frac::test

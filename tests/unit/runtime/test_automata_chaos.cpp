@@ -1,7 +1,6 @@
 // The chaos game: reproducible streams, probabilities, graph-directed automata, threads.
 #include "runtime/automata/chaos.hpp"
-#include "runtime/automata/points.hpp"
-#include "runtime/automata/tree.hpp"
+#include "runtime/automata/tabulate.hpp"
 #include "runtime/dimension.hpp"
 #include "tests/unit/automata_examples.hpp"
 
@@ -96,31 +95,41 @@ TEST_CASE("the same seed and thread count give the same density", "[automata][ch
     CHECK(a.outside < 100);
 }
 
-TEST_CASE("graph-directed chaos: a projected B-spline through a transient initial state",
-          "[automata][chaos]") {
-    // Every point lies on the curve: near one of the tree's leaf points at depth 12 (4096 of them).
-    const ir::Automaton q = bspline(2, {{0, 0}, {1, 2}, {3, 2}, {4, 0}});
-    std::vector<std::array<double, 2>> curve;
-    const auto pb = rt::attractor_point(q, 1);
-    rt::walk_tree(q, {12, false}, [&](const rt::TreeNode& node) {
-        if (!node.leaf) return;
-        double x = 0, y = 0;
-        for (std::size_t c = 0; c < 3; ++c) x += (*node.op)(0, c) * pb[c], y += (*node.op)(1, c) * pb[c];
-        curve.push_back({x, y});
-    });
-    REQUIRE(curve.size() == 4096);
-    double worst = 0;
-    double xmin = 10, xmax = -10;
-    rt::chaos_points(q, 2000, 50, 3, [&](const std::vector<double>& p) {
+namespace {
+
+// How far chaos-game points stray from a curve tabulated at 2^12 parameters, and their x range.
+struct Spread {
+    double worst = 0, xmin = 1e9, xmax = -1e9;
+};
+
+Spread spread_from_curve(const ir::Automaton& a) {
+    const rt::Tabulation curve =
+        rt::tabulate(a, 12 / static_cast<int>(std::log2(a.arcs_from(a.initial).size())));
+    Spread s;
+    rt::chaos_points(a, 2000, 50, 3, [&](const std::vector<double>& p) {
         double best = 1e9;
-        for (const auto& c : curve) best = std::min(best, std::hypot(p[0] - c[0], p[1] - c[1]));
-        worst = std::max(worst, best);
-        xmin = std::min(xmin, p[0]), xmax = std::max(xmax, p[0]);
+        for (const auto& c : curve.values) best = std::min(best, std::hypot(p[0] - c[0], p[1] - c[1]));
+        s.worst = std::max(s.worst, best);
+        s.xmin = std::min(s.xmin, p[0]), s.xmax = std::max(s.xmax, p[0]);
     });
-    CHECK(worst < 5e-3);
-    // Both segments are visited: the curve runs from (0.5, 1) to (3.5, 1).
-    CHECK(xmin < 0.7);
-    CHECK(xmax > 3.3);
+    return s;
+}
+
+} // namespace
+
+TEST_CASE("graph-directed chaos: B-splines through a transient or a barycentric initial state",
+          "[automata][chaos]") {
+    // A CIFS whose initial state a is transient: every point lies on the curve, both segments are
+    // visited (the curve runs from (0.5, 1) to (3.5, 1)).
+    const Spread cifs = spread_from_curve(bspline(2, {{0, 0}, {1, 2}, {3, 2}, {4, 0}}));
+    CHECK(cifs.worst < 5e-3);
+    CHECK(cifs.xmin < 0.7);
+    CHECK(cifs.xmax > 3.3);
+    // A projected IFS: the points are projected by the control points (from (1, 2) to (4, 2.5)).
+    const Spread projected = spread_from_curve(projected_quadratic({{0, 0}, {2, 4}, {6, 1}}));
+    CHECK(projected.worst < 5e-3);
+    CHECK(projected.xmin < 1.2);
+    CHECK(projected.xmax > 3.8);
 }
 
 TEST_CASE("chaos game errors and the density picture", "[automata][chaos]") {

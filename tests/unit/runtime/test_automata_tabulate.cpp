@@ -73,14 +73,8 @@ TEST_CASE("quadratic and cubic B-spline CIFS tabulated at i/2^p equal de Boor", 
 }
 
 TEST_CASE("a projected IFS: the barycentric initial state with control points", "[automata][tabulate]") {
-    // One quadratic segment as Guérin's projected attractor P A: the initial state is bary(3).
     const Points pts{{0, 0}, {2, 4}, {6, 1}};
-    ir::Automaton a = bspline(2, pts);
-    a.arcs.erase(a.arcs.begin()); // drop the segment arcs of a
-    for (auto& arc : a.arcs) arc.from = arc.to = 0;
-    a.states.erase(a.states.begin());
-    a.initial = 0;
-    a.projection = ir::Operator::from_exact(control_points(pts, 0, 3));
+    const ir::Automaton a = projected_quadratic(pts);
     const rt::Tabulation t = rt::tabulate(a, 8);
     REQUIRE(t.values.size() == 256);
     for (std::size_t i = 0; i < 256; ++i) {
