@@ -260,6 +260,8 @@ ContractivityResult prove_contractive(const Automaton& a, const ContractivityOpt
     const std::vector<int> comp = strongly_connected_components(a, live, &components);
 
     ContractivityResult result;
+    double cube = 1; // d^3 for the largest direction dimension d: the cost of one product
+    for (std::size_t i : arcs) cube = std::max(cube, std::pow(static_cast<double>(lin[i].rows()), 3.0));
     // Paths of length L from each state, counted in doubles to respect the product budget.
     std::vector<double> paths(n, 1.0);
     std::size_t products = 0;
@@ -273,7 +275,9 @@ ContractivityResult prove_contractive(const Automaton& a, const ContractivityOpt
             total += more[s];
         }
         paths = more;
-        if (static_cast<double>(products) + total > static_cast<double>(options.max_products)) break;
+        if (static_cast<double>(products) + total > static_cast<double>(options.max_products) ||
+            (static_cast<double>(products) + total) * cube > options.max_work)
+            break;
         products += static_cast<std::size_t>(total);
         // M_L[a][b]: the largest bound over the paths a -> ... -> b of this length.
         Matrix<Interval> m(n, n);

@@ -30,6 +30,9 @@ struct AutomatonProblem {
 struct ContractivityOptions {
     int max_length = 12;               // longest paths tried
     std::size_t max_products = 400000; // matrix products over all lengths tried
+    // The same budget in arithmetic: products times d^3 for the largest direction dimension d, so
+    // that systems of bary(16) spaces stop at shorter paths than plane IFS (a refusal stays quick).
+    double max_work = 5e7;
 };
 
 // How contraction was proven, or why not.
