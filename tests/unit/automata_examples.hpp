@@ -210,4 +210,26 @@ inline ir::Automaton projected_quadratic(const std::vector<std::pair<long, long>
     return a;
 }
 
+// A tensor-product B-spline patch of degree 2 or 3 as a one-state IFS in bary((degree + 1)^2):
+// T_(sigma, tau) = T_sigma (x) T_tau of the curve's subdivision matrices, arc sigma * 2 + tau, weight
+// index a * (degree + 1) + b. No projection.
+inline ir::Automaton tensor_patch(int degree) {
+    const std::size_t k = static_cast<std::size_t>(degree) + 1;
+    std::vector<std::pair<long, long>> points;
+    for (std::size_t i = 0; i < k; ++i) points.emplace_back(static_cast<long>(i), 0);
+    const ir::Automaton curve = bspline(degree, points);
+    const Matrix<Rational> t[2] = {*curve.arcs[1].op.exact, *curve.arcs[2].op.exact};
+    ir::Automaton patch;
+    patch.name = "patch";
+    patch.states.push_back(state("p", ir::Space::barycentric(static_cast<int>(k * k))));
+    for (int s = 0; s < 2; ++s)
+        for (int u = 0; u < 2; ++u) {
+            Matrix<Rational> m(k * k, k * k);
+            for (std::size_t r = 0; r < k * k; ++r)
+                for (std::size_t c = 0; c < k * k; ++c) m(r, c) = t[s](r / k, c / k) * t[u](r % k, c % k);
+            patch.arcs.push_back(arc(0, 0, m, "T" + std::to_string(s) + std::to_string(u)));
+        }
+    return patch;
+}
+
 } // namespace frac::test

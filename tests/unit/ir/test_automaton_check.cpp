@@ -194,17 +194,7 @@ TEST_CASE("non-finite operator entries are located errors", "[automaton_check]")
 TEST_CASE("a tensor-product cubic patch in bary(16)", "[automaton_check]") {
     // T_(s, t) = T_s (x) T_t of the cubic subdivision: contractive by products along paths; with one
     // map replaced by the identity the loop on it is refused, within the work budget.
-    const ir::Automaton cubic = bspline(3, {{0, 0}, {1, 0}, {2, 0}, {3, 0}});
-    const Matrix<Rational> t[2] = {*cubic.arcs[1].op.exact, *cubic.arcs[2].op.exact};
-    ir::Automaton patch;
-    patch.states.push_back(state("p", ir::Space::barycentric(16)));
-    for (int s = 0; s < 2; ++s)
-        for (int u = 0; u < 2; ++u) {
-            Matrix<Rational> k(16, 16);
-            for (std::size_t r = 0; r < 16; ++r)
-                for (std::size_t c = 0; c < 16; ++c) k(r, c) = t[s](r / 4, c / 4) * t[u](r % 4, c % 4);
-            patch.arcs.push_back(arc(0, 0, k, "T" + std::to_string(s) + std::to_string(u)));
-        }
+    ir::Automaton patch = tensor_patch(3);
     ir::ContractivityResult proof;
     CHECK(ir::check_automaton(patch, {}, &proof).empty());
     CHECK(proof.proven);

@@ -87,17 +87,7 @@ TEST_CASE("a projected IFS: the barycentric initial state with control points", 
 TEST_CASE("surface tabulation of a tensor-product patch", "[automata][tabulate]") {
     // bary(9) with T_(sigma, tau) = T_sigma (x) T_tau of the quadratic subdivision, projected by a
     // 3 x 3 grid of points in R3: F(s, t) is the tensor-product quadratic B-spline patch.
-    const ir::Automaton curve = bspline(2, {{0, 0}, {1, 0}, {2, 0}});
-    const Matrix<Rational> t[2] = {*curve.arcs[1].op.exact, *curve.arcs[2].op.exact};
-    ir::Automaton patch;
-    patch.states.push_back(state("p", ir::Space::barycentric(9)));
-    for (int s = 0; s < 2; ++s)
-        for (int u = 0; u < 2; ++u) {
-            Matrix<Rational> k(9, 9);
-            for (std::size_t r = 0; r < 9; ++r)
-                for (std::size_t c = 0; c < 9; ++c) k(r, c) = t[s](r / 3, c / 3) * t[u](r % 3, c % 3);
-            patch.arcs.push_back(arc(0, 0, k, "T" + std::to_string(s) + std::to_string(u)));
-        }
+    ir::Automaton patch = tensor_patch(2);
     Matrix<Rational> grid(4, 9);
     auto height = [](std::size_t a, std::size_t b) { return static_cast<long>((a * 7 + b * 3) % 5); };
     for (std::size_t a = 0; a < 3; ++a)
