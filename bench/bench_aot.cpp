@@ -5,7 +5,7 @@
 //
 //   bench_aot FRAC_BINARY [level=9] [json=bench_aot.json] [work_dir=.]
 #include "backend/llvm/jit.hpp"
-#include "frontend/driver.hpp"
+#include "driver/pipeline.hpp"
 #include "ir/tape.hpp"
 
 #include <bit>
@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
     const std::string model = work + "/bench_aot_carpet.frac";
     std::ofstream(model) << "import \"fractals\";\n";
 
-    auto c = front::compile_file(model);
+    auto c = driver::compile_file(model);
     if (!c->ok()) {
         std::cerr << c->diags.render(c->sources);
         return 1;

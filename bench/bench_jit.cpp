@@ -8,7 +8,7 @@
 #include "backend/llvm/jit.hpp"
 #include "bench/bench_common.hpp"
 #include "bench/carpet_handwritten.hpp"
-#include "frontend/driver.hpp"
+#include "driver/pipeline.hpp"
 #include "ir/tape.hpp"
 #include "runtime/rss.hpp"
 
@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
     std::vector<Shape> shapes;
     std::set<std::string> seen;
     for (const auto& [file, text] : front::embedded_stdlib()) {
-        auto c = front::compile_source("bench.frac", "import \"" + file + "\";");
+        auto c = driver::compile_source("bench.frac", "import \"" + file + "\";");
         if (!c->ok()) {
             std::cerr << c->diags.render(c->sources);
             return 1;

@@ -8,7 +8,7 @@
 // (boundary boxes: what looseness costs), and ns per box with the interpreter and the JIT.
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/jit.hpp"
-#include "frontend/driver.hpp"
+#include "driver/pipeline.hpp"
 #include "ir/tape.hpp"
 #include "runtime/rss.hpp"
 
@@ -86,7 +86,7 @@ int main() {
         shape coset_disks over [-2, 2] × [-2, 2] = lattice_distance((x, y), (1, 0), (1/2, sqrt(3) / 2), (0, 0)) - 0.3;
         shape reduced_disks over [-2, 2] × [-2, 2] =
             lattice_distance_reduced((x, y), (1, 0), (1/2, sqrt(3) / 2), (0, 0)) - 0.3;)";
-    auto c = front::compile_source("bench_lattice.frac", source);
+    auto c = driver::compile_source("bench_lattice.frac", source);
     if (!c->ok()) {
         std::cerr << c->diags.render(c->sources);
         return 1;

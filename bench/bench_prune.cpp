@@ -11,7 +11,7 @@
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/jit.hpp"
 #include "bench/bench_common.hpp"
-#include "frontend/driver.hpp"
+#include "driver/pipeline.hpp"
 #include "ir/specialize.hpp"
 #include "ir/tape.hpp"
 #include "runtime/rss.hpp"
@@ -34,8 +34,8 @@ using bench::Shape;
 
 // The named shape of a model file (relative to the source tree) or of a stdlib module.
 Shape load(const std::string& source, const std::string& name, bool is_file) {
-    auto c = is_file ? front::compile_file(std::string(FRAC_SOURCE_DIR) + "/" + source)
-                     : front::compile_source("bench.frac", "import \"" + source + "\";");
+    auto c = is_file ? driver::compile_file(std::string(FRAC_SOURCE_DIR) + "/" + source)
+                     : driver::compile_source("bench.frac", "import \"" + source + "\";");
     if (!c->ok()) {
         std::cerr << c->diags.render(c->sources);
         std::exit(1);

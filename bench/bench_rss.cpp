@@ -1,7 +1,7 @@
 // RSS covers of the standard library's shapes: boxes per second, and the effect of adaptive series
 // truncation, each variant measured in the same run. Prints a table of ratios and writes JSON.
 #include "backend/interp/interpreter.hpp"
-#include "frontend/driver.hpp"
+#include "driver/pipeline.hpp"
 #include "ir/tape.hpp"
 #include "runtime/rss.hpp"
 
@@ -46,7 +46,7 @@ Row measure(const front::Module& m, const front::ShapeInfo& s, int depth, const 
 int main(int argc, char** argv) {
     const int depth = argc > 1 ? std::atoi(argv[1]) : 10;
     const std::string json_path = argc > 2 ? argv[2] : "bench_rss.json";
-    auto c = front::compile_source("bench.frac", "import \"fractals\";");
+    auto c = driver::compile_source("bench.frac", "import \"fractals\";");
     if (!c->ok()) {
         std::cerr << c->diags.render(c->sources);
         return 1;
@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
     }
     // Parallel subdivision: the same cover with 1 and 2 threads, and the memory peak of deep covers,
     // each measured in a child process so that peaks do not mix.
-    auto c3 = front::compile_source("bench3.frac", "import \"solids\";");
+    auto c3 = driver::compile_source("bench3.frac", "import \"solids\";");
     struct Deep {
         const front::Module* module;
         const char* shape;

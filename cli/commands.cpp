@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <memory>
+#include <optional>
 
 #include <algorithm>
 #include <cmath>
@@ -23,49 +24,47 @@
 
 namespace frac::cli {
 
-int run_check(const std::string& file, const std::string& emit, const std::string& shape) {
-    const auto stop = emit == "ast" ? front::StopAfter::parse : front::StopAfter::elaborate;
-    auto c = compile_or_report(file, stop);
+int run_check(const std::string& file, const std::string& emit, const std::string& shape, bool time_passes) {
+    std::optional<driver::Stage> stage;
+    if (!emit.empty()) {
+        stage = driver::find_stage(emit);
+        if (!stage)
+            throw UsageError(
+                fmt::format("--emit={}: no such stage (stages: {})", emit, driver::stage_names()));
+    }
+    driver::PassTimes times;
+    driver::PassTimes* timing = time_passes ? &times : nullptr;
+    // The frontend runs as far as the stage shown (all of it for the backend stages).
+    auto c = compile_or_report(file, stage ? std::min(*stage, driver::Stage::lower) : driver::Stage::lower,
+                               timing);
     if (!c) return front::exit_compile_error;
-    if (emit == "ast") {
-        std::cout << front::print_ast(c->program, 1); // the file itself, not its imports
-        return 0;
+    std::vector<std::string> shapes;
+    if (!shape.empty()) shapes.push_back(find_shape(*c, shape).name);
+    try {
+        if (stage)
+            std::cout << driver::emit(*c, *stage, shapes, timing);
+        else if (time_passes) // every stage runs, so every stage is timed
+            (void)driver::emit(*c, jit::jit_available() ? driver::Stage::codegen : driver::Stage::specialize,
+                               shapes, timing);
+    } catch (const std::runtime_error& e) {
+        std::cerr << "frac: error: --emit=" << emit << ": " << e.what() << "\n";
+        return 1;
     }
+    if (time_passes) std::cerr << times.report();
     const front::Module& m = c->module;
-    std::vector<const front::ShapeInfo*> shapes;
-    if (!shape.empty())
-        shapes.push_back(&find_shape(*c, shape));
-    else
-        for (const auto& s : m.shapes) shapes.push_back(&s);
-    for (const front::ShapeInfo* s : shapes) {
-        if (emit == "ir") {
-            std::cout << fmt::format("shape {} ({} coordinates):\n{}", s->name, s->dimension,
-                                     ir::print_graph(m.graph, {s->root}));
-        } else if (emit == "tape") {
-            std::cout << fmt::format("shape {}:\n{}", s->name,
-                                     ir::print_tape(ir::build_tape(m.graph, s->root, s->dimension)));
-        } else if (emit == "llvm") {
-            std::string why;
-            if (!jit::jit_available(&why)) {
-                std::cerr << "frac: error: --emit=llvm needs the LLVM backend, which cannot be used here: "
-                          << why << "\n";
-                return 1;
-            }
-            // The optimised module the JIT compiles for this host (frac compile --emit-llvm writes the
-            // one of a compiled model, with its C entry points).
-            std::cout << fmt::format("; shape {}\n{}", s->name,
-                                     jit::emit_llvm(ir::build_tape(m.graph, s->root, s->dimension)));
-        }
-    }
     if (emit.empty()) {
         // The file's own shapes and tests: imported modules' are not its work (file 1 is the main file).
         const auto own = [](const auto& items) {
             return std::count_if(items.begin(), items.end(), [](const auto& i) { return i.loc.file == 1; });
         };
-        const auto counted = [](std::ptrdiff_t n, const char* noun) {
-            return fmt::format("{} {}{}", n, noun, n == 1 ? "" : "s");
+        const auto counted = [](std::ptrdiff_t n, const char* noun, const char* nouns = nullptr) {
+            return n == 1  ? fmt::format("1 {}", noun)
+                   : nouns ? fmt::format("{} {}", n, nouns)
+                           : fmt::format("{} {}s", n, noun);
         };
-        std::cout << fmt::format("{}: ok ({}, {})\n", file, counted(own(m.shapes), "shape"),
+        const auto automata = own(m.automata);
+        std::cout << fmt::format("{}: ok ({}{}, {})\n", file, counted(own(m.shapes), "shape"),
+                                 automata ? ", " + counted(automata, "automaton", "automata") : "",
                                  counted(own(m.tests), "test"));
     }
     return 0;

@@ -14,7 +14,9 @@ struct RenderOptions {
     bool force = false; // write an SVG over the size limit
 };
 
-int run_check(const std::string& file, const std::string& emit, const std::string& shape);
+// --emit=STAGE prints what a stage of the pipeline produced (driver/pipeline.hpp); --time-passes runs
+// every stage and prints the time of each on stderr.
+int run_check(const std::string& file, const std::string& emit, const std::string& shape, bool time_passes);
 int run_eval(const std::string& file, const std::string& shape, const std::string& at, const std::string& box,
              const EngineOptions& engine);
 // Largest file `render` and `mesh` write without --force (an estimate, checked before writing).

@@ -45,9 +45,10 @@ int main(int argc, char** argv) {
     std::string file, shape, emit, at, box;
     auto* check = app.add_subcommand("check", "parse, check and lower a model; --emit shows a stage");
     check->add_option("file", file, "model file")->required();
-    check->add_option("--emit", emit, "print the ast, the ir graph, the tape or the JIT's LLVM IR")
-        ->check(CLI::IsMember({"ast", "ir", "tape", "llvm"}));
+    check->add_option("--emit", emit, "print what a stage produced: " + driver::stage_names());
     check->add_option("--shape", shape, "only this shape");
+    bool time_passes = false;
+    check->add_flag("--time-passes", time_passes, "run every stage and print the time of each on stderr");
     add_set(check);
 
     auto* eval = app.add_subcommand("eval", "evaluate a shape at a point or over a box");
@@ -198,7 +199,7 @@ int main(int argc, char** argv) {
                                               front::list_names(names)));
         }
         cli::set_constant_overrides(sets);
-        if (*check) return cli::run_check(file, emit, shape);
+        if (*check) return cli::run_check(file, emit, shape, time_passes);
         if (*eval) return cli::run_eval(file, shape, at, box, engine);
         if (*render) return cli::run_render(file, render_options, engine);
         if (*dimension) return cli::run_dimension(file, shape, from, to, split, engine);

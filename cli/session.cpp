@@ -1,11 +1,5 @@
 #include "cli/session.hpp"
 
-#include "backend/interp/interpreter.hpp"
-#include "backend/llvm/aot.hpp"
-#include "backend/llvm/jit.hpp"
-#include "runtime/dimension.hpp"
-#include "runtime/rss.hpp"
-
 #include "frontend/suggest.hpp"
 
 #include <cerrno>
@@ -38,8 +32,13 @@ void set_constant_overrides(const std::vector<std::string>& sets) {
     }
 }
 
-std::unique_ptr<front::Compilation> compile_or_report(const std::string& path, front::StopAfter stop) {
-    auto c = front::compile_file(path, {}, stop, constant_overrides);
+std::unique_ptr<front::Compilation> compile_or_report(const std::string& path, driver::Stage stop,
+                                                      driver::PassTimes* times) {
+    driver::CompileOptions options;
+    options.stop = stop;
+    options.overrides = constant_overrides;
+    options.times = times;
+    auto c = driver::compile_file(path, options);
     if (!c->unknown_overrides.empty()) {
         // A --set of a constant the model lacks is a command-line mistake, reported before any diagnostic.
         const std::string& name = c->unknown_overrides.front();
@@ -78,37 +77,6 @@ const front::ShapeInfo& pick_shape(const front::Compilation& c, const std::strin
     return c.module.shapes.back();
 }
 
-std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId root, int inputs,
-                                              const EngineOptions& options) {
-    ir::Tape tape = ir::build_tape(m.graph, root, inputs);
-    if (std::string defect = ir::verify_tape(tape); !defect.empty())
-        throw front::InternalError("malformed tape: " + defect);
-    if (options.engine == "jit") {
-        std::string why;
-        if (jit::jit_available(&why)) {
-            try {
-                return jit::make_jit(tape, options.eval);
-            } catch (const jit::JitError& e) {
-                why = e.what();
-            }
-        }
-        static bool told = false; // say it once per run
-        if (!told)
-            std::cerr << fmt::format("frac: note: the JIT cannot be used ({}); using the interpreter\n", why);
-        told = true;
-    } else if (options.engine == "aot") {
-        // Asked for by name, so no fallback: a model that cannot be compiled and loaded is an error.
-        try {
-            return jit::make_aot(tape, options.eval);
-        } catch (const jit::JitError& e) {
-            throw RunError(fmt::format("the aot engine cannot be used: {}", e.what()));
-        }
-    } else if (options.engine != "interp") {
-        throw RunError(fmt::format("unknown engine '{}' (available: jit, interp, aot)", options.engine));
-    }
-    return interp::make_interpreter(std::move(tape), options.eval);
-}
-
 namespace {
 
 std::vector<std::string> split(const std::string& text, char sep) {
@@ -134,7 +102,7 @@ ConstantValue evaluate_constant(const std::string& text, const std::string& what
     // The text is the body of a constant of an otherwise empty model: the language's own parser,
     // name resolution and constant checks apply, and nothing of the user's model is in scope.
     const std::string source = "const value = " + text + ";\nprint value;\n";
-    auto c = front::compile_source("<command line>", source);
+    auto c = driver::compile_source("<command line>", source);
     if (!c->ok() || c->program.items.size() != 2 || c->module.prints.size() != 1 ||
         c->module.prints[0].kind != front::ValueKind::scalar) {
         std::string why = "not a number";
@@ -148,7 +116,9 @@ ConstantValue evaluate_constant(const std::string& text, const std::string& what
                                      what, text, why));
     }
     const front::Module& m = c->module;
-    auto eval = interp::make_interpreter(ir::build_tape(m.graph, m.prints[0].nodes[0], 0), {});
+    EngineOptions interpreted;
+    interpreted.engine = "interp"; // one evaluation: compiling would cost more than it saves
+    auto eval = make_evaluator(m, m.prints[0].nodes[0], 0, interpreted);
     ConstantValue v;
     v.enclosure = eval->eval_box(nullptr);
     v.point = eval->eval_point(nullptr);
@@ -203,38 +173,6 @@ std::vector<double> parse_point(const std::string& text, int dimension,
 std::string format_interval(ir::Interval v) {
     if (v.is_empty()) return "empty";
     return fmt::format("[{}, {}]", v.lo, v.hi);
-}
-
-std::vector<ir::Interval> answer_queries(const front::Module& m, const ir::Tape& tape,
-                                         const EngineOptions& options,
-                                         std::vector<std::optional<ir::Interval>>& answers) {
-    answers.resize(m.queries.size());
-    std::vector<ir::Interval> inputs(m.queries.size(), ir::Interval(0.0));
-    for (std::size_t k = 0; k < tape.input_slots.size(); ++k) {
-        if (tape.input_slots[k] == ir::no_slot) continue;
-        if (!answers[k]) {
-            const front::Query& q = m.queries[k];
-            const front::ShapeInfo& s = m.shapes[q.shape];
-            auto eval = make_evaluator(m, s.root, s.dimension, options);
-            if (q.kind == front::Query::Kind::enclose) {
-                answers[k] = eval->eval_box(q.box.data());
-            } else {
-                rt::RssOptions ro;
-                ro.depth = q.to;
-                ro.split = q.split;
-                ro.keep_cells = false;
-                ro.threads = options.threads;
-                try {
-                    const rt::RssResult r = rt::subdivide(*eval, q.box, ro);
-                    answers[k] = ir::Interval(rt::box_counting(r, q.from, q.to).dimension);
-                } catch (const std::invalid_argument& e) {
-                    throw RunError(fmt::format("dimension of '{}': {}", s.name, e.what()));
-                }
-            }
-        }
-        inputs[k] = *answers[k];
-    }
-    return inputs;
 }
 
 } // namespace frac::cli

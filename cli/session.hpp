@@ -1,8 +1,9 @@
 // What every command does first: compile a model, report its diagnostics, and make evaluators.
 #pragma once
 
-#include "frontend/driver.hpp"
-#include "ir/evaluator.hpp"
+#include "driver/engines.hpp"
+#include "driver/pipeline.hpp"
+#include "driver/queries.hpp"
 #include "ir/tape.hpp"
 
 #include <memory>
@@ -12,16 +13,9 @@
 
 namespace frac::cli {
 
-struct EngineOptions {
-    std::string engine = "jit"; // or "interp" (the fallback when the JIT cannot be used), "aot"
-    ir::EvalOptions eval;
-    int threads = 0; // subdivision threads; 0: all cores
-};
-
-// A user-facing run-time failure (I/O, a computation that cannot be done): message and exit code 1.
-struct RunError : std::runtime_error {
-    using std::runtime_error::runtime_error;
-};
+using driver::EngineOptions;
+using driver::make_evaluator;
+using driver::RunError;
 
 // A mistake on the command line (unknown shape, bad number, wrong output name): exit code 64.
 struct UsageError : std::runtime_error {
@@ -33,8 +27,10 @@ struct UsageError : std::runtime_error {
 void set_constant_overrides(const std::vector<std::string>& sets);
 
 // Compiles `path`; on errors prints the diagnostics to stderr and returns null.
+// `times`, when not null, gets the time of each stage run.
 std::unique_ptr<front::Compilation> compile_or_report(const std::string& path,
-                                                      front::StopAfter stop = front::StopAfter::elaborate);
+                                                      driver::Stage stop = driver::Stage::lower,
+                                                      driver::PassTimes* times = nullptr);
 
 // A constant expression given on the command line (`1/3`, `sqrt(2)/2`, `pi/4`), evaluated by the
 // language itself in an empty module: its proven enclosure and its point value. `what` names it in
@@ -52,18 +48,10 @@ const front::ShapeInfo& find_shape(const front::Compilation& c, const std::strin
 // The shape named, or the model's only/first shape when `name` is empty.
 const front::ShapeInfo& pick_shape(const front::Compilation& c, const std::string& name);
 
-std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId root, int inputs,
-                                              const EngineOptions& options);
-
 // Parses "x0:x1,y0:y1[,z0:z1]" into an outward box; "x,y" into a point (and its outward enclosure).
 std::vector<ir::Interval> parse_box(const std::string& text, int dimension);
 std::vector<double> parse_point(const std::string& text, int dimension, std::vector<ir::Interval>* enclosure);
 
 std::string format_interval(ir::Interval v);
-
-// Runs the model's queries (enclose, dimension) that `tape` reads, caching answers in `answers`.
-std::vector<ir::Interval> answer_queries(const front::Module& m, const ir::Tape& tape,
-                                         const EngineOptions& options,
-                                         std::vector<std::optional<ir::Interval>>& answers);
 
 } // namespace frac::cli

@@ -25,6 +25,7 @@ enum class ExprKind {
               // and for an orbit series (orbit_var in orbit(kids[3], orbit_map)) the initial point,
               // then the escape radius kids[4] when there is one
     lambda,   // fn (a, b) = body, an argument: bindings: the parameters (values null); kids[0]: body
+    matrix,   // [[a, b], [c, d]]: kids: the rows, each a tuple of its entries
 };
 
 struct Expr;
@@ -55,7 +56,7 @@ struct Expr {
     std::vector<Binding> bindings;
 };
 
-enum class ItemKind { import, fn, const_, shape, test, print };
+enum class ItemKind { import, fn, const_, shape, test, print, automaton };
 
 struct Param {
     std::string name;
@@ -68,6 +69,37 @@ struct Expect {
     ExprPtr within; // tolerance, or null
 };
 
+// An automaton (ifs, cifs): states with their spaces, arcs a -> b carrying an operator from the space
+// of b into the space of a (A_a is the union of T(A_b) over its arcs), an initial state.
+struct SpaceDecl {
+    bool barycentric = false;
+    int n = 2; // R^n, or bary(n) (n weights)
+    Location loc;
+};
+
+struct StateDecl {
+    std::string name;
+    Location loc;
+    SpaceDecl space;
+    ExprPtr primitive; // drawn at the leaves of evaluation trees, or null
+};
+
+struct ArcDecl {
+    std::string from, to, label; // label: the operator's name (T0), may be empty
+    Location loc, from_loc, to_loc;
+    ExprPtr op;
+    ExprPtr probability; // or null
+};
+
+struct AutomatonDecl {
+    bool graph_directed = false; // cifs; an ifs has one state, named as the automaton
+    std::vector<StateDecl> states;
+    std::vector<ArcDecl> arcs;
+    std::string initial; // empty: the first state
+    Location initial_loc;
+    ExprPtr projection; // project = controls(...): for a barycentric initial state, or null
+};
+
 struct Item {
     ItemKind kind;
     Location loc;
@@ -78,6 +110,7 @@ struct Item {
     ExprPtr over;                // shape: default box, or null
     ExprPtr body;                // fn/const/shape/print
     std::vector<Expect> expects; // test
+    std::shared_ptr<AutomatonDecl> automaton;
 };
 
 struct Program {

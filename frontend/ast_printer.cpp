@@ -61,6 +61,7 @@ std::string print_expr(const Expr& e) {
     case ExprKind::tuple: return fmt::format("(point{})", kids());
     case ExprKind::field: return fmt::format("(. {}{})", e.text, kids());
     case ExprKind::interval: return fmt::format("(interval{})", kids());
+    case ExprKind::matrix: return fmt::format("(matrix{})", kids());
     case ExprKind::lambda: {
         std::string names;
         for (const Binding& b : e.bindings) names += (names.empty() ? "" : " ") + b.name;
@@ -101,6 +102,22 @@ std::string print_ast(const Program& p, std::uint32_t file) {
             out += ")\n";
             break;
         case ItemKind::print: out += fmt::format("(print {})\n", print_expr(*it.body)); break;
+        case ItemKind::automaton: {
+            const AutomatonDecl& a = *it.automaton;
+            out += fmt::format("({} {}", a.graph_directed ? "cifs" : "ifs", it.name);
+            for (const StateDecl& s : a.states)
+                out += fmt::format("\n  (state {} {}{}{})", s.name, s.space.barycentric ? "bary" : "R",
+                                   s.space.n,
+                                   s.primitive ? " (primitive " + print_expr(*s.primitive) + ")" : "");
+            for (const ArcDecl& arc : a.arcs)
+                out += fmt::format("\n  (arc {} {}{} {}{})", arc.from, arc.to,
+                                   arc.label.empty() ? "" : " " + arc.label, print_expr(*arc.op),
+                                   arc.probability ? " (prob " + print_expr(*arc.probability) + ")" : "");
+            if (!a.initial.empty()) out += fmt::format("\n  (initial {})", a.initial);
+            if (a.projection) out += fmt::format("\n  (project {})", print_expr(*a.projection));
+            out += ")\n";
+            break;
+        }
         }
     }
     return out;

@@ -23,7 +23,16 @@ constexpr Builtin builtins[] = {
     {"mod", BuiltinKind::mod, 2, 2, Op::Mod1},
     {"pow", BuiltinKind::pow, 2, 2, Op::Pow},
     {"enclose", BuiltinKind::enclose, 2, 2, Op::Const},
-    {"dimension", BuiltinKind::dimension, 3, 4, Op::Const},
+    {"dimension", BuiltinKind::dimension, 1, 4, Op::Const},
+    {"translate", BuiltinKind::transform, 2, 3, Op::Const},
+    {"rotate", BuiltinKind::transform, 1, 1, Op::Const},
+    {"scale", BuiltinKind::transform, 1, 3, Op::Const},
+    {"shear", BuiltinKind::transform, 2, 2, Op::Const},
+    {"controls", BuiltinKind::controls, 2, 16, Op::Const},
+    {"point", BuiltinKind::primitive, 1, 1, Op::Const},
+    {"segment", BuiltinKind::primitive, 2, 2, Op::Const},
+    {"polyline", BuiltinKind::primitive, 0, 64, Op::Const},
+    {"polygon", BuiltinKind::primitive, 0, 64, Op::Const},
 };
 
 } // namespace
@@ -41,7 +50,7 @@ std::vector<std::string> builtin_names() {
 }
 
 bool is_builtin_constant(const std::string& name) {
-    return name == "pi" || name == "e";
+    return name == "pi" || name == "e" || name == "identity";
 }
 
 } // namespace frac::front

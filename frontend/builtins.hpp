@@ -16,7 +16,10 @@ enum class BuiltinKind {
     mod,       // mod(x, m)
     pow,       // pow(x, y) = x^y
     enclose,   // enclose(shape, box): a proven enclosure (tests and print only)
-    dimension, // dimension(shape, from: a, to: b [, split: s]) (tests and print only)
+    dimension, // dimension(shape, from: a, to: b [, split: s]), dimension(automaton) (tests and print only)
+    transform, // translate, rotate, scale, shear: an affine map of R2 or R3 (constant arguments)
+    controls,  // controls(P0, ..., Pn-1): the projection of bary(n) by control points
+    primitive, // point, segment, polyline, polygon: what a state of an automaton draws
 };
 
 struct Builtin {
@@ -27,7 +30,7 @@ struct Builtin {
 };
 
 const Builtin* find_builtin(const std::string& name);
-bool is_builtin_constant(const std::string& name); // pi, e
+bool is_builtin_constant(const std::string& name); // pi, e, identity (the identity transform)
 std::vector<std::string> builtin_names();          // the builtin functions, for suggestions
 
 } // namespace frac::front

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "frontend/diagnostics.hpp"
+#include "ir/automaton.hpp"
 #include "ir/graph.hpp"
 
 #include <string>
@@ -21,11 +22,20 @@ struct ShapeInfo {
     NodeId root = ir::no_node; // reads Var(k) = coordinate k
 };
 
-// A run-time question a test asks of a shape; its answer is the input Var(index) of test graphs.
-struct Query {
-    enum class Kind { enclose, dimension } kind = Kind::enclose;
+// An ifs or cifs: its automaton IR and where its parts are written.
+struct AutomatonInfo {
+    std::string name;
     Location loc;
-    std::size_t shape = 0;           // index into Module::shapes
+    ir::Automaton automaton;
+    std::vector<Location> state_locs, arc_locs; // by state and arc index
+};
+
+// A run-time question a test asks of a shape or an automaton; its answer is the input Var(index) of
+// test graphs.
+struct Query {
+    enum class Kind { enclose, dimension, automaton_dimension } kind = Kind::enclose;
+    Location loc;
+    std::size_t shape = 0;           // index into Module::shapes (Module::automata for automaton_dimension)
     std::vector<Interval> box;       // enclose: the box; dimension: the root box
     int from = 0, to = 0, split = 2; // dimension: levels used for box counting
 };
@@ -55,6 +65,7 @@ struct PrintInfo {
 struct Module {
     ir::Graph graph;
     std::vector<ShapeInfo> shapes;
+    std::vector<AutomatonInfo> automata;
     std::vector<Query> queries;
     std::vector<TestInfo> tests;
     std::vector<PrintInfo> prints;
@@ -62,6 +73,11 @@ struct Module {
     const ShapeInfo* find_shape(const std::string& name) const {
         for (const ShapeInfo& s : shapes)
             if (s.name == name) return &s;
+        return nullptr;
+    }
+    const AutomatonInfo* find_automaton(const std::string& name) const {
+        for (const AutomatonInfo& a : automata)
+            if (a.name == name) return &a;
         return nullptr;
     }
 };

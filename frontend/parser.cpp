@@ -65,7 +65,7 @@ private:
             const bool anonymous_fn = k == Tok::kw_fn && ahead(1).kind == Tok::lparen; // not an item
             if (depth == 0 &&
                 ((k == Tok::kw_fn && !anonymous_fn) || k == Tok::kw_const || k == Tok::kw_shape ||
-                 k == Tok::kw_test || k == Tok::kw_import || k == Tok::kw_print))
+                 k == Tok::kw_test || k == Tok::kw_import || k == Tok::kw_print || at_automaton()))
                 return;
             take();
             if (k == Tok::lbrace) ++depth;
@@ -78,10 +78,18 @@ private:
         }
     }
 
+    // `ifs` and `cifs` are words of the language only where a definition starts (they stay usable as
+    // names elsewhere).
+    bool at_automaton() const {
+        return at(Tok::ident) && (cur().text == "ifs" || cur().text == "cifs") && ahead(1).kind == Tok::ident;
+    }
+    bool at_word(const char* word) const { return at(Tok::ident) && cur().text == word; }
+
     // ---- items ----
     Item item() {
         Item it;
         it.loc = cur().loc;
+        if (at_automaton()) return automaton(std::move(it));
         switch (cur().kind) {
         case Tok::kw_import:
             take();
@@ -149,9 +157,134 @@ private:
             expect(Tok::semicolon, "after print");
             return it;
         default:
-            fail(fmt::format("expected a definition (fn, const, shape, test, import or print), found {}",
-                             describe(cur())));
+            fail(fmt::format(
+                "expected a definition (fn, const, shape, ifs, cifs, test, import or print), found {}",
+                describe(cur())));
         }
+    }
+
+    // ifs NAME in SPACE { [LABEL =] OP [prob P]; ... [primitive = E;] }
+    // cifs NAME { state a, b in SPACE; a -> b : [LABEL =] OP [prob P]; initial a; primitive a = E;
+    //             project = controls(...); }
+    Item automaton(Item it) {
+        const bool graph_directed = take().text == "cifs";
+        it.kind = ItemKind::automaton;
+        it.name = expect(Tok::ident, graph_directed ? "after 'cifs'" : "after 'ifs'").text;
+        auto a = std::make_shared<AutomatonDecl>();
+        a->graph_directed = graph_directed;
+        if (!graph_directed) {
+            if (!at(Tok::kw_in))
+                fail("expected 'in' and the space of the ifs (R2, R3 or bary(n)) after its name");
+            take();
+            a->states.push_back({it.name, it.loc, space(), nullptr});
+        }
+        expect(Tok::lbrace, "to open the automaton");
+        while (!at(Tok::rbrace) && !at(Tok::end)) {
+            try {
+                automaton_stmt(*a, it.name);
+            } catch (const CompileError& e) {
+                diags_.error(e.loc, e.what());
+                while (!at(Tok::semicolon) && !at(Tok::rbrace) && !at(Tok::end)) take();
+                accept(Tok::semicolon);
+            }
+        }
+        expect(Tok::rbrace, "to close the automaton");
+        it.automaton = std::move(a);
+        return it;
+    }
+
+    void automaton_stmt(AutomatonDecl& a, const std::string& name) {
+        if (a.graph_directed && at_word("state")) {
+            take();
+            std::vector<std::pair<std::string, Location>> names;
+            do {
+                const Token& n = expect(Tok::ident, "as a state name");
+                names.emplace_back(n.text, n.loc);
+            } while (accept(Tok::comma));
+            expect(Tok::kw_in, "and the states' space (R2, R3 or bary(n))");
+            const SpaceDecl s = space();
+            for (auto& [n, loc] : names) a.states.push_back({n, loc, s, nullptr});
+        } else if (a.graph_directed && at_word("initial")) {
+            take();
+            const Token& n = expect(Tok::ident, "(the initial state) after 'initial'");
+            a.initial = n.text;
+            a.initial_loc = n.loc;
+        } else if (at_word("primitive")) {
+            take();
+            std::string state = name;
+            Location loc = cur().loc;
+            if (a.graph_directed) {
+                const Token& n = expect(Tok::ident, "(the state) after 'primitive'");
+                state = n.text;
+                loc = n.loc;
+            }
+            expect(Tok::assign, "before the primitive");
+            ExprPtr e = expr();
+            bool found = false;
+            for (StateDecl& s : a.states)
+                if (s.name == state) {
+                    s.primitive = std::move(e);
+                    found = true;
+                }
+            if (!found) throw CompileError(loc, fmt::format("no state '{}' in this automaton", state));
+        } else if (a.graph_directed && at_word("project")) {
+            take();
+            expect(Tok::assign, "after 'project'");
+            a.projection = expr();
+        } else {
+            ArcDecl arc;
+            arc.loc = cur().loc;
+            if (a.graph_directed) {
+                const Token& from = expect(Tok::ident, "(a state, or state, initial, primitive, project)");
+                arc.from = from.text;
+                arc.from_loc = from.loc;
+                expect(Tok::minus, "and '>' (an arc: a -> b : T)");
+                expect(Tok::gt, "after '-' (an arc: a -> b : T)");
+                const Token& to = expect(Tok::ident, "(the arc's target state) after '->'");
+                arc.to = to.text;
+                arc.to_loc = to.loc;
+                expect(Tok::colon, "before the arc's operator");
+            } else {
+                arc.from = arc.to = name;
+                arc.from_loc = arc.to_loc = arc.loc;
+            }
+            if (at(Tok::ident) && ahead(1).kind == Tok::assign) {
+                arc.label = take().text;
+                take();
+            }
+            arc.op = expr();
+            if (at_word("prob")) {
+                take();
+                arc.probability = expr();
+            }
+            a.arcs.push_back(std::move(arc));
+        }
+        expect(Tok::semicolon, "after the statement");
+    }
+
+    // R2, R3 or bary(n).
+    SpaceDecl space() {
+        SpaceDecl s;
+        s.loc = cur().loc;
+        if (at(Tok::ident) && (cur().text == "R2" || cur().text == "R3")) {
+            s.n = cur().text == "R2" ? 2 : 3;
+            take();
+            return s;
+        }
+        if (at_word("bary")) {
+            take();
+            expect(Tok::lparen, "after 'bary'");
+            const Token& n = expect(Tok::number, "(the number of weights) in bary(n)");
+            const int v = std::atoi(n.text.c_str());
+            if (v < 2 || v > 16 || n.text.find_first_not_of("0123456789") != std::string::npos)
+                throw CompileError(n.loc,
+                                   fmt::format("bary(n) needs an integer n from 2 to 16, not {}", n.text));
+            expect(Tok::rparen, "after bary(n)");
+            s.barycentric = true;
+            s.n = v;
+            return s;
+        }
+        fail(fmt::format("expected a space (R2, R3 or bary(n)), found {}", describe(cur())));
     }
 
     std::vector<Param> params() {
@@ -384,6 +517,7 @@ private:
             return e;
         }
         case Tok::lbracket: {
+            if (ahead(1).kind == Tok::lbracket) return matrix();
             auto e = make(ExprKind::interval, take().loc);
             e->kids.push_back(expr());
             expect(Tok::comma, "between the interval's bounds");
@@ -395,6 +529,23 @@ private:
             fail("an anonymous function 'fn (...) = ...' is only an argument, where a function is expected");
         default: fail(fmt::format("expected an expression, found {}", describe(tok)));
         }
+    }
+
+    // [[a, b, c], [d, e, f]]: a matrix, row by row.
+    ExprPtr matrix() {
+        auto m = make(ExprKind::matrix, take().loc);
+        do {
+            auto row = make(ExprKind::tuple, expect(Tok::lbracket, "to open a matrix row").loc);
+            do row->kids.push_back(expr());
+            while (accept(Tok::comma));
+            expect(Tok::rbracket, "to close the matrix row");
+            if (!m->kids.empty() && row->kids.size() != m->kids.front()->kids.size())
+                throw CompileError(row->loc, fmt::format("this row has {} entries, the first row {}",
+                                                         row->kids.size(), m->kids.front()->kids.size()));
+            m->kids.push_back(std::move(row));
+        } while (accept(Tok::comma));
+        expect(Tok::rbracket, "to close the matrix");
+        return m;
     }
 
     // fn (a, b) = body: an anonymous function, passed as an argument where a function is expected.

@@ -1,7 +1,7 @@
 #include "frontend/resolve.hpp"
 
 #include "frontend/builtins.hpp"
-#include "frontend/driver.hpp"
+#include "frontend/loader.hpp"
 #include "frontend/suggest.hpp"
 
 #include <algorithm>
@@ -156,6 +156,40 @@ private:
             expr(*e.expr);
             if (e.within) expr(*e.within);
         }
+        if (it.automaton) automaton(*it.automaton);
+    }
+
+    // States are names of their automaton only: each defined once, every arc and the initial state
+    // naming one of them.
+    void automaton(const AutomatonDecl& a) {
+        std::map<std::string, Location> states;
+        for (const StateDecl& s : a.states) {
+            if (auto [pos, added] = states.emplace(s.name, s.loc); !added) {
+                d_.error(s.loc, fmt::format("state '{}' is already defined", s.name));
+                d_.note(pos->second, fmt::format("'{}' was first defined here", s.name));
+            }
+            if (s.primitive) expr(*s.primitive);
+        }
+        std::vector<std::string> names;
+        for (const auto& [n, loc] : states) names.push_back(n);
+        const auto known = [&](const std::string& name, Location loc, const char* what) {
+            if (states.count(name)) return;
+            const auto near = closest_name(name, names);
+            d_.error(loc,
+                     fmt::format("{} '{}' is no state of this automaton{} (states: {})", what, name,
+                                 near ? fmt::format("; did you mean '{}'?", *near) : "", list_names(names)));
+        };
+        for (const ArcDecl& arc : a.arcs) {
+            known(arc.from, arc.from_loc, "the arc's source");
+            known(arc.to, arc.to_loc, "the arc's target");
+            expr(*arc.op);
+            if (arc.probability) expr(*arc.probability);
+        }
+        if (!a.initial.empty()) known(a.initial, a.initial_loc, "the initial state");
+        if (a.projection) expr(*a.projection);
+        if (a.states.empty())
+            d_.error(checked_->loc, fmt::format("automaton '{}' has no state", checked_->name));
+        if (a.arcs.empty()) d_.error(checked_->loc, fmt::format("automaton '{}' has no map", checked_->name));
     }
 
     // The kind of a local name: `value`, a function parameter's arity, or nullopt when not local.
@@ -239,6 +273,7 @@ private:
         case ExprKind::tuple:
         case ExprKind::field:
         case ExprKind::interval:
+        case ExprKind::matrix:
             for (const ExprPtr& k : e.kids) expr(*k);
             return;
         }

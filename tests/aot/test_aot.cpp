@@ -65,7 +65,7 @@ struct JitModel {
 };
 JitModel jit_model(const std::string& path, const frac::ir::EvalOptions& options = {}) {
     JitModel m;
-    m.c = frac::front::compile_file(path);
+    m.c = frac::driver::compile_file(path);
     REQUIRE(m.c->ok());
     for (const frac::front::ShapeInfo& s : m.c->module.shapes) {
         m.eval[s.name] =

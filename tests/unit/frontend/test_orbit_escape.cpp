@@ -1,5 +1,5 @@
 // Escape certificates of orbit series: what the compiler derives, and what it refuses.
-#include "frontend/driver.hpp"
+#include "driver/pipeline.hpp"
 #include "ir/series_tail.hpp"
 
 #include <catch2/catch.hpp>
@@ -25,7 +25,7 @@ const ir::Node& root_of(const Compilation& c, const char* shape) {
 }
 
 std::string errors_of(const std::string& text) {
-    auto c = compile_source("t.frac", text);
+    auto c = driver::compile_source("t.frac", text);
     return c->diags.render(c->sources);
 }
 
@@ -36,10 +36,10 @@ const char* polar_map =
 } // namespace
 
 TEST_CASE("the Koch map: |M(q)| >= 3|q| - 1 gives the escape radius 1/2", "[escape]") {
-    auto c =
-        compile_source("t.frac", std::string(polar_map) +
-                                     "shape s(x, y) = min(k in 0.., p in orbit((x, y), fold) escape 1/2, "
-                                     "(sqrt(p.x^2 + p.y^2) - 0.25) / 3^k);");
+    auto c = driver::compile_source("t.frac",
+                                    std::string(polar_map) +
+                                        "shape s(x, y) = min(k in 0.., p in orbit((x, y), fold) escape 1/2, "
+                                        "(sqrt(p.x^2 + p.y^2) - 0.25) / 3^k);");
     REQUIRE(c->ok());
     const ir::Node& n = root_of(*c, "s");
     REQUIRE(n.op == ir::Op::SeriesMin);
@@ -60,10 +60,11 @@ TEST_CASE("the Koch map: |M(q)| >= 3|q| - 1 gives the escape radius 1/2", "[esca
 TEST_CASE("no Lipschitz bound without a continuous fold", "[escape]") {
     // atan2(p.y, p.x) jumps across the negative x axis: the certificate holds, the Lipschitz bound is not
     // claimed.
-    auto c = compile_source("t.frac", "fn m(p) = let r = sqrt(p.x^2 + p.y^2), f = atan2(p.y, p.x) / 2 in "
-                                      "(3 * r * cos(f) - 1, 3 * r * sin(f));\n"
-                                      "shape s(x, y) = min(k in 0.., p in orbit((x, y), m) escape 1/2, "
-                                      "(sqrt(p.x^2 + p.y^2) - 0.25) / 3^k);");
+    auto c =
+        driver::compile_source("t.frac", "fn m(p) = let r = sqrt(p.x^2 + p.y^2), f = atan2(p.y, p.x) / 2 in "
+                                         "(3 * r * cos(f) - 1, 3 * r * sin(f));\n"
+                                         "shape s(x, y) = min(k in 0.., p in orbit((x, y), m) escape 1/2, "
+                                         "(sqrt(p.x^2 + p.y^2) - 0.25) / 3^k);");
     REQUIRE(c->ok());
     CHECK(escape_of(*c, "s").lipschitz == 0.0);
 }
@@ -89,7 +90,7 @@ TEST_CASE("escape bounds: a box outside the ball bounds every later term", "[esc
 }
 
 TEST_CASE("signed permutations in 3D and max series are certified", "[escape]") {
-    auto c = compile_source(
+    auto c = driver::compile_source(
         "t.frac",
         "fn m(p) = (3 * abs(p.y) - 1, -3 * p.z, 3 * abs(p.x));\n"
         "shape s(x, y) = min(k in 0.., p in orbit((x, y, 0), m) escape 0.6, (sqrt(p.x^2 + p.y^2 + p.z^2) - "

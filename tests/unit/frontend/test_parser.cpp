@@ -1,5 +1,5 @@
+#include "driver/pipeline.hpp"
 #include "frontend/ast.hpp"
-#include "frontend/driver.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -8,7 +8,9 @@ using namespace frac::front;
 namespace {
 
 std::string ast_of(const std::string& text, std::string* errors = nullptr) {
-    auto c = compile_source("t.frac", text, {}, StopAfter::parse);
+    frac::driver::CompileOptions options;
+    options.stop = frac::driver::Stage::parse;
+    auto c = frac::driver::compile_source("t.frac", text, options);
     if (errors)
         *errors = c->diags.render(c->sources);
     else if (!c->ok())

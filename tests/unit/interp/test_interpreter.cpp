@@ -1,5 +1,5 @@
 #include "backend/interp/interpreter.hpp"
-#include "frontend/driver.hpp"
+#include "driver/pipeline.hpp"
 #include "ir/tape.hpp"
 
 #include <catch2/catch.hpp>
@@ -16,7 +16,7 @@ struct Shape {
 
 Shape shape(const std::string& text, const std::string& name = "s", ir::EvalOptions options = {}) {
     Shape s;
-    s.c = front::compile_source("t.frac", text);
+    s.c = driver::compile_source("t.frac", text);
     if (!s.c->ok()) FAIL(s.c->diags.render(s.c->sources));
     const front::ShapeInfo* info = s.c->module.find_shape(name);
     REQUIRE(info);

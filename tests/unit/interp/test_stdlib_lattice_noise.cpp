@@ -2,7 +2,7 @@
 // enumeration on random reduced bases, and enclosures over random boxes that must meet the enclosure
 // of every sampled point (which contains the exact value), for noise, lattice distances and eq. (12).
 #include "backend/interp/interpreter.hpp"
-#include "frontend/driver.hpp"
+#include "driver/pipeline.hpp"
 #include "ir/tape.hpp"
 
 #include <catch2/catch.hpp>
@@ -26,7 +26,7 @@ struct Model {
 
 Model compile(const std::string& text) {
     Model m;
-    m.c = front::compile_source("t.frac", text);
+    m.c = driver::compile_source("t.frac", text);
     if (!m.c->ok()) FAIL(m.c->diags.render(m.c->sources));
     return m;
 }

@@ -5,7 +5,7 @@
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/aot.hpp"
 #include "backend/llvm/jit.hpp"
-#include "frontend/driver.hpp"
+#include "driver/pipeline.hpp"
 #include "ir/graph.hpp"
 #include "ir/tape.hpp"
 
@@ -79,7 +79,7 @@ struct Model {
 
 inline Model compile(const std::string& text) {
     Model m;
-    m.c = front::compile_source("t.frac", text);
+    m.c = driver::compile_source("t.frac", text);
     if (!m.c->ok()) FAIL(m.c->diags.render(m.c->sources));
     for (const front::ShapeInfo& s : m.c->module.shapes)
         m.tapes.push_back(ir::build_tape(m.c->module.graph, s.root, s.dimension));

@@ -155,7 +155,7 @@ void check_random_series(std::uint64_t seed, int count, std::size_t points) {
     int series = 0;
     for (int n = 0; n < count; ++n) {
         const std::string expr = sm.series();
-        auto c = front::compile_source("t.frac", "shape s(x, y) = " + expr + ";");
+        auto c = driver::compile_source("t.frac", "shape s(x, y) = " + expr + ";");
         INFO(expr << "\n" << c->diags.render(c->sources));
         REQUIRE(c->ok()); // every generated series has a provable tail
         ++series;

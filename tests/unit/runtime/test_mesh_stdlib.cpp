@@ -3,7 +3,7 @@
 // cubes inside, and meshes to the same surface as the digit-exact test evaluator; the CSG example
 // examples/menger_frame.frac meshes to a closed surface with the Euler characteristic derived below.
 #include "backend/interp/interpreter.hpp"
-#include "frontend/driver.hpp"
+#include "driver/pipeline.hpp"
 #include "ir/tape.hpp"
 #include "mesh_euler.hpp"
 #include "runtime/rss.hpp"
@@ -42,10 +42,10 @@ Compiled compile(std::unique_ptr<front::Compilation> c, const std::string& shape
 // The level-k sponge of the standard library in lattice units, over [0, 3^k]^3.
 Compiled sponge(int k) {
     const std::string side = std::to_string(Menger(k, true).n);
-    return compile(front::compile_source("t.frac", "import \"solids\";\nshape s(x, y, z) over [0, " + side +
-                                                       "] × [0, " + side + "] × [0, " + side +
-                                                       "] = menger_lattice((x, y, z), " + std::to_string(k) +
-                                                       ");"),
+    return compile(driver::compile_source("t.frac", "import \"solids\";\nshape s(x, y, z) over [0, " + side +
+                                                        "] × [0, " + side + "] × [0, " + side +
+                                                        "] = menger_lattice((x, y, z), " + std::to_string(k) +
+                                                        ");"),
                    "s");
 }
 
@@ -125,7 +125,7 @@ TEST_CASE("stdlib sponge: deeper covers add no inside cells", "[mesh][stdlib]") 
 }
 
 TEST_CASE("stdlib sponge: the stdlib shape menger3 is the level-2 sponge", "[mesh][stdlib]") {
-    Compiled m = compile(front::compile_source("t.frac", "import \"solids\";"), "menger3");
+    Compiled m = compile(driver::compile_source("t.frac", "import \"solids\";"), "menger3");
     const RssResult r = cover(m, 2, true);
     CHECK(r.inside == 400);
     CHECK(check_mesh(mesh_cover(r, MeshSelection::inside)).euler == 2 * menger_solid_euler(2));
@@ -146,7 +146,7 @@ TEST_CASE("stdlib sponge: the stdlib shape menger3 is the level-2 sponge", "[mes
 // two parts meet only along an edge or at a corner), and its surface has chi = 2 (-1300) = -2600.
 TEST_CASE("CSG example: the sponge in its collar meshes to the exact Euler characteristic",
           "[mesh][stdlib]") {
-    Compiled m = compile(front::compile_file(std::string(FRAC_SOURCE_DIR) + "/examples/menger_frame.frac"),
+    Compiled m = compile(driver::compile_file(std::string(FRAC_SOURCE_DIR) + "/examples/menger_frame.frac"),
                          "sponge_in_frame");
     const std::int64_t chi_sponge = menger_solid_euler(3);
     const std::int64_t chi_contact = 4 * (3 * carpet_euler(2) - 2) - 4;

@@ -1,6 +1,6 @@
 // Parallel subdivision gives the same cover, cell for cell, whatever the thread count.
 #include "backend/interp/interpreter.hpp"
-#include "frontend/driver.hpp"
+#include "driver/pipeline.hpp"
 #include "ir/tape.hpp"
 #include "runtime/rss.hpp"
 
@@ -11,7 +11,7 @@ using namespace frac;
 namespace {
 
 rt::RssResult cover(const std::string& shape, int depth, int threads, int split = 2) {
-    static auto c = front::compile_source("t.frac", "import \"fractals\";\nimport \"solids\";");
+    static auto c = driver::compile_source("t.frac", "import \"fractals\";\nimport \"solids\";");
     REQUIRE(c->ok());
     const front::ShapeInfo* s = c->module.find_shape(shape);
     REQUIRE(s);

@@ -1,10 +1,11 @@
-#include "frontend/driver.hpp"
+#include "frontend/loader.hpp"
 
 #include "frontend/resolve.hpp"
 #include "frontend/suggest.hpp"
 
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fmt/format.h>
@@ -45,14 +46,11 @@ class Qualifier {
 public:
     Qualifier(const std::string& alias, Program& module) : alias_(alias) {
         for (const Item& it : module.items)
-            if (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape)
-                globals_.insert(it.name);
+            if (is_definition(it.kind)) globals_.insert(it.name);
     }
 
     void rename(Item& it) {
-        if (globals_.count(it.name) &&
-            (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape))
-            it.name = qualified(it.name);
+        if (globals_.count(it.name) && is_definition(it.kind)) it.name = qualified(it.name);
         locals_.clear();
         std::set<std::string> params;
         for (const Param& p : it.params) params.insert(p.name);
@@ -64,9 +62,25 @@ public:
             expr(*e.expr);
             if (e.within) expr(*e.within);
         }
+        if (it.automaton) {
+            // The automaton is shared with the item only: it can be renamed in place.
+            for (StateDecl& st : it.automaton->states) {
+                if (!it.automaton->graph_directed) st.name = it.name;
+                if (st.primitive) expr(*st.primitive);
+            }
+            for (ArcDecl& arc : it.automaton->arcs) {
+                if (!it.automaton->graph_directed) arc.from = arc.to = it.name;
+                expr(*arc.op);
+                if (arc.probability) expr(*arc.probability);
+            }
+            if (it.automaton->projection) expr(*it.automaton->projection);
+        }
     }
 
 private:
+    static bool is_definition(ItemKind k) {
+        return k == ItemKind::fn || k == ItemKind::const_ || k == ItemKind::shape || k == ItemKind::automaton;
+    }
     std::string qualified(const std::string& name) const { return alias_ + "." + name; }
     bool global(const std::string& name) const {
         for (const auto& scope : locals_)
@@ -117,11 +131,19 @@ private:
 
 class Loader {
 public:
-    Loader(Compilation& c, Program& into) : c_(c), into_(into) {}
+    Loader(Compilation& c, Program& into, LoadTimes* times) : c_(c), into_(into), times_(times) {}
 
     void load(const std::string& name, const std::string& text, const std::filesystem::path& dir) {
         const std::uint32_t file = c_.sources.add(name, text);
-        Program p = parse(lex(text, file, c_.diags), c_.diags);
+        using clock = std::chrono::steady_clock;
+        const auto t0 = clock::now();
+        std::vector<Token> tokens = lex(text, file, c_.diags);
+        const auto t1 = clock::now();
+        Program p = parse(tokens, c_.diags);
+        if (times_) {
+            times_->lex += std::chrono::duration<double>(t1 - t0).count();
+            times_->parse += std::chrono::duration<double>(clock::now() - t1).count();
+        }
         for (Item& it : p.items) {
             if (it.kind == ItemKind::import) import(it, dir);
             into_.items.push_back(std::move(it));
@@ -170,7 +192,7 @@ private:
         // A qualified module is loaded on its own (its imports too), then its names get the prefix: it
         // shares nothing with the importing files but what they reach through the prefix.
         Program module;
-        Loader(c_, module).load(name, text, module_dir);
+        Loader(c_, module, times_).load(name, text, module_dir);
         Qualifier q(it.alias, module);
         for (Item& m : module.items) {
             q.rename(m);
@@ -180,11 +202,14 @@ private:
 
     Compilation& c_;
     Program& into_;
+    LoadTimes* times_;
     std::set<std::string> seen_;
 };
 
-// Replaces the body of every constant named by an override with the override's expression, parsed
-// as a file of its own so that its diagnostics point into the command line's text.
+} // namespace
+
+// Each override's expression is parsed as a file of its own, so that its diagnostics point into the
+// command line's text.
 void apply_overrides(Compilation& c, const ConstOverrides& overrides) {
     for (const auto& [name, value] : overrides) {
         bool found = false;
@@ -201,23 +226,8 @@ void apply_overrides(Compilation& c, const ConstOverrides& overrides) {
     }
 }
 
-void finish(Compilation& c, const Limits& limits, StopAfter stop) {
-    if (stop == StopAfter::parse || c.diags.has_errors()) return;
-    resolve_names(c.program, c.diags);
-    if (stop == StopAfter::resolve || c.diags.has_errors()) return;
-    elaborate(c.program, c.sources, limits, c.module, c.diags);
-    if (std::string defect = ir::verify_graph(c.module.graph); !defect.empty())
-        throw InternalError("malformed expression graph: " + defect);
-}
-
-} // namespace
-
-std::unique_ptr<Compilation> compile_source(const std::string& name, const std::string& text,
-                                            const Limits& limits, StopAfter stop) {
-    auto c = std::make_unique<Compilation>();
-    Loader(*c, c->program).load(name, text, std::filesystem::current_path());
-    finish(*c, limits, stop);
-    return c;
+void load_source(Compilation& c, const std::string& name, const std::string& text, LoadTimes* times) {
+    Loader(c, c.program, times).load(name, text, std::filesystem::current_path());
 }
 
 bool is_identifier(const std::string& text) {
@@ -227,19 +237,14 @@ bool is_identifier(const std::string& text) {
     return true;
 }
 
-std::unique_ptr<Compilation> compile_file(const std::string& path, const Limits& limits, StopAfter stop,
-                                          const ConstOverrides& overrides) {
-    auto c = std::make_unique<Compilation>();
+bool load_file(Compilation& c, const std::string& path, LoadTimes* times) {
     std::string text, why;
     if (!read_file(path, text, why)) {
-        c->diags.error({}, fmt::format("cannot read '{}': {}", path, why));
-        return c;
+        c.diags.error({}, fmt::format("cannot read '{}': {}", path, why));
+        return false;
     }
-    Loader(*c, c->program).load(path, text, std::filesystem::path(path).parent_path());
-    apply_overrides(*c, overrides);
-    if (!c->unknown_overrides.empty()) return c;
-    finish(*c, limits, stop);
-    return c;
+    Loader(c, c.program, times).load(path, text, std::filesystem::path(path).parent_path());
+    return true;
 }
 
 } // namespace frac::front

@@ -1,4 +1,4 @@
-#include "frontend/driver.hpp"
+#include "driver/pipeline.hpp"
 #include "ir/tape.hpp"
 
 #include <catch2/catch.hpp>
@@ -9,19 +9,19 @@ using namespace frac::front;
 namespace {
 
 std::unique_ptr<Compilation> compile_ok(const std::string& text) {
-    auto c = compile_source("t.frac", text);
+    auto c = driver::compile_source("t.frac", text);
     if (!c->ok()) FAIL(c->diags.render(c->sources));
     return c;
 }
 
 std::string errors_of(const std::string& text) {
-    auto c = compile_source("t.frac", text);
+    auto c = driver::compile_source("t.frac", text);
     return c->diags.render(c->sources);
 }
 
 } // namespace
 
-TEST_CASE("functions and lets are inlined into one hash-consed graph", "[elaborate]") {
+TEST_CASE("functions and lets are inlined into one hash-consed graph", "[lower]") {
     auto c = compile_ok("fn sq(a) = a * a;\nshape s(x, y) = let d = sq(x) + sq(y) in d - sq(x) - 1;");
     const ShapeInfo* s = c->module.find_shape("s");
     REQUIRE(s);
@@ -33,7 +33,7 @@ TEST_CASE("functions and lets are inlined into one hash-consed graph", "[elabora
     CHECK(ir::verify_tape(t).empty());
 }
 
-TEST_CASE("constants fold to outward enclosures", "[elaborate]") {
+TEST_CASE("constants fold to outward enclosures", "[lower]") {
     auto c = compile_ok("const third = 1 / 3;\nshape s(x, y) = x - third;");
     const auto& g = c->module.graph;
     const ir::Node& root = g[c->module.find_shape("s")->root];
@@ -45,7 +45,7 @@ TEST_CASE("constants fold to outward enclosures", "[elaborate]") {
     CHECK(k.value.contains(1.0 / 3.0));
 }
 
-TEST_CASE("the default box and dimension of shapes", "[elaborate]") {
+TEST_CASE("the default box and dimension of shapes", "[lower]") {
     auto c = compile_ok("shape a = x + y;\nshape b over [0, 1] × [0, 1] × [-1, 1] = x + y + z;\nshape c(u, "
                         "v) over [2, 3] × [4, 5] = u;");
     CHECK(c->module.find_shape("a")->dimension == 2);
@@ -111,7 +111,7 @@ TEST_CASE("nested series and loop-invariant hoisting", "[series][tape]") {
     CHECK(inner_in_main);
 }
 
-TEST_CASE("type errors are reported at the offending expression", "[elaborate]") {
+TEST_CASE("type errors are reported at the offending expression", "[lower]") {
     const std::string e =
         errors_of("shape s(x, y) = (x, y) * (x, y);\nfn f(p) = p.x;\nshape t(x, y) = f(1);");
     CHECK(e.find("t.frac:1:24: error: points multiply or divide by numbers only") != std::string::npos);

@@ -1,8 +1,11 @@
-#include "frontend/elaborate.hpp"
+#include "frontend/lower.hpp"
 
 #include "frontend/builtins.hpp"
+#include "frontend/inliner.hpp"
+#include "frontend/operators.hpp"
 #include "frontend/orbit_escape.hpp"
 #include "frontend/series_bounds.hpp"
+#include "frontend/typecheck.hpp"
 #include "numeric/rational.hpp"
 
 #include <cmath>
@@ -18,20 +21,10 @@ using ir::Op;
 
 namespace {
 
-const char* kind_name(ValueKind k) {
-    switch (k) {
-    case ValueKind::scalar: return "a number";
-    case ValueKind::boolean: return "a condition";
-    case ValueKind::point: return "a point";
-    case ValueKind::interval: return "an interval";
-    case ValueKind::box: return "a box";
-    }
-    return "a value";
-}
-
 struct Closure;
 
-// A typed value during elaboration.
+// A value during lowering: its graph nodes (or constant box) and, for a function or shape used as a
+// value, which one.
 struct Value {
     ValueKind kind = ValueKind::scalar;
     std::vector<NodeId> nodes;
@@ -40,7 +33,9 @@ struct Value {
     // A function passed as an argument (resolve_names checked its uses): inlined where it is called.
     const Item* function = nullptr;
     const Builtin* builtin = nullptr;
-    std::shared_ptr<const Closure> closure; // an anonymous function
+    std::shared_ptr<const Closure> closure;    // an anonymous function
+    const Item* automaton = nullptr;           // an ifs or cifs named as a value (dimension, dist)
+    std::shared_ptr<const LinearValue> linear; // a matrix or a transform (operators of automata)
 
     static Value of(ValueKind kind, NodeId n) {
         Value v;
@@ -50,41 +45,63 @@ struct Value {
     }
     static Value scalar(NodeId n) { return of(ValueKind::scalar, n); }
     static Value boolean(NodeId n) { return of(ValueKind::boolean, n); }
-};
 
-using Scope = std::vector<std::pair<std::string, Value>>;
+    // Its type, for the typing rules (types.hpp) that the type checker applied before.
+    Type type() const {
+        if (shape) return Type{Type::Kind::shape};
+        if (function || builtin || closure) return Type{Type::Kind::function};
+        if (automaton) return Type{Type::Kind::automaton};
+        if (linear && linear->transform) return Type::transform(linear->dimension);
+        if (linear)
+            return Type::matrix(static_cast<int>(linear->in(0).rows()),
+                                static_cast<int>(linear->in(0).cols()));
+        switch (kind) {
+        case ValueKind::scalar: return Type::number();
+        case ValueKind::boolean: return Type::boolean();
+        case ValueKind::point: return Type::point(static_cast<int>(nodes.size()));
+        case ValueKind::interval: return Type::interval();
+        case ValueKind::box: return Type::box(static_cast<int>(box.size()));
+        }
+        return Type::number();
+    }
+};
 
 // An anonymous function with the scopes it was written in. It is only ever an argument, so it is
 // called while those scopes (and the series whose indices they hold) are still active.
 struct Closure {
     const Expr* lambda;
-    std::vector<Scope> scopes;
+    std::vector<std::vector<std::pair<std::string, Value>>> scopes;
 };
 
-// Where an expression is elaborated: what it may use.
-enum class Context { shape, constant, test };
-
-class Elaborator {
+class Lowering : Inliner<Value> {
 public:
-    Elaborator(const Program& p, const SourceManager& sm, const Limits& limits, Module& m, Diagnostics& d)
-        : p_(p), sm_(sm), limits_(limits), m_(m), g_(m.graph), d_(d) {}
+    Lowering(const Program& p, const TypedProgram& typed, const SourceManager& sm, const Limits& limits,
+             Module& m, Diagnostics& d)
+        : Inliner(limits.max_inline_depth), p_(p), typed_(typed), sm_(sm), limits_(limits), m_(m),
+          g_(m.graph), d_(d) {}
 
     void run() {
         for (const Item& it : p_.items) {
-            if (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape)
+            if (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape ||
+                it.kind == ItemKind::automaton)
                 globals_[it.name] = &it;
         }
-        // Shapes first, in source order, so that tests can refer to any of them.
+        // Shapes first, in source order, so that tests can refer to any of them; then automata.
         for (const Item& it : p_.items)
-            if (it.kind == ItemKind::shape) guarded([&] { shape_info(it); });
+            if (it.kind == ItemKind::shape && !typed_.failed.count(&it)) guarded([&] { shape_info(it); });
+        for (const Item& it : p_.items)
+            if (it.kind == ItemKind::automaton && !typed_.failed.count(&it))
+                guarded([&] { automaton_info(it); });
         for (const Item& it : p_.items) {
+            if (typed_.failed.count(&it)) continue; // its type error is reported
             switch (it.kind) {
             case ItemKind::const_: guarded([&] { constant(it); }); break;
             case ItemKind::test: test(it); break;
             case ItemKind::print: guarded([&] { print(it); }); break;
             case ItemKind::import:
             case ItemKind::fn:
-            case ItemKind::shape: break;
+            case ItemKind::shape:
+            case ItemKind::automaton: break;
             }
         }
     }
@@ -129,24 +146,10 @@ private:
         ShapeInfo info;
         info.name = it.name;
         info.loc = it.loc;
-        if (it.over) {
-            const Value box = closed(*it.over, Context::constant, true);
-            if (box.kind != ValueKind::box)
-                fail(it.over->loc, fmt::format("'over' needs a box such as [0, 1] × [0, 1], found {}",
-                                               kind_name(box.kind)));
-            info.box = box.box;
-        }
-        if (it.has_params) {
-            info.dimension = static_cast<int>(it.params.size());
-        } else {
-            info.dimension = info.box.empty() ? 2 : static_cast<int>(info.box.size());
-        }
-        if (info.dimension < 2 || info.dimension > 3)
-            fail(it.loc, fmt::format("a shape has 2 or 3 coordinates, '{}' has {}", it.name, info.dimension));
+        // The type checker checked the box and the dimension.
+        info.dimension = typed_.items.at(&it).size;
+        if (it.over) info.box = closed(*it.over, Context::constant, true).box;
         if (info.box.empty()) info.box.assign(static_cast<std::size_t>(info.dimension), Interval{0.0, 1.0});
-        if (static_cast<int>(info.box.size()) != info.dimension)
-            fail(it.over->loc, fmt::format("shape '{}' has {} coordinates but its box has {} axes", it.name,
-                                           info.dimension, info.box.size()));
         std::vector<Value> coords;
         for (int k = 0; k < info.dimension; ++k) coords.push_back(Value::scalar(g_.var(k)));
         info.root = shape_body(it, coords, it.loc);
@@ -163,11 +166,7 @@ private:
         for (int k = 0; k < dim; ++k)
             scope.emplace_back(it.has_params ? it.params[static_cast<std::size_t>(k)].name : implicit[k],
                                coords[static_cast<std::size_t>(k)]);
-        const Value v = inline_body(it, std::move(scope), call_loc, Context::shape);
-        if (v.kind != ValueKind::scalar)
-            fail(it.body->loc, fmt::format("a shape's function must be a number (negative inside), found {}",
-                                           kind_name(v.kind)));
-        return v.nodes[0];
+        return scalar(inline_body(it, std::move(scope), call_loc, Context::shape), it.body->loc);
     }
 
     void constant(const Item& it) {
@@ -197,25 +196,20 @@ private:
         t.name = it.name;
         t.loc = it.loc;
         for (const Expect& e : it.expects) {
+            if (typed_.failed.count(&e)) continue;
             guarded([&] {
                 Expectation x;
                 x.loc = e.loc;
                 x.source = sm_.line_text(e.loc);
                 if (e.within) {
                     const Expr& cmp = *e.expr;
-                    if (cmp.kind != ExprKind::binary || cmp.op != Tok::eq)
-                        fail(e.within->loc, "'within' needs an equality: expect a == b within tolerance");
                     const NodeId a = scalar(closed(*cmp.kids[0], Context::test), cmp.kids[0]->loc);
                     const NodeId b = scalar(closed(*cmp.kids[1], Context::test), cmp.kids[1]->loc);
                     const NodeId tol = scalar(closed(*e.within, Context::test), e.within->loc);
                     x.truth = g_.op(Op::Le, g_.op(Op::Abs, g_.op(Op::Sub, a, b)), tol);
                     x.shown = {a, b};
                 } else {
-                    const Value v = closed(*e.expr, Context::test);
-                    if (v.kind != ValueKind::boolean)
-                        fail(e.expr->loc,
-                             fmt::format("'expect' needs a condition, found {}", kind_name(v.kind)));
-                    x.truth = v.nodes[0];
+                    x.truth = boolean(closed(*e.expr, Context::test), e.expr->loc);
                     if (e.expr->kind == ExprKind::binary && e.expr->kids.size() == 2) {
                         for (const ExprPtr& side : e.expr->kids) {
                             const Value s = closed(*side, Context::test);
@@ -231,37 +225,22 @@ private:
 
     void print(const Item& it) {
         const Value v = closed(*it.body, Context::test);
-        if (v.shape)
-            fail(it.body->loc, "cannot print a shape; print enclose(shape, box) or its value at a point");
         m_.prints.push_back({it.loc, v.kind, v.nodes, v.box});
     }
 
     // ---- scopes and inlining ----
-    struct Frame {
-        Context ctx;
-        std::vector<Scope> scopes;
-        int level = 0; // series nesting
-    };
-
     Value closed(const Expr& e, Context ctx, bool box_expected = false) {
-        Frame f{ctx, {}, 0};
-        frames_.push_back(std::move(f));
-        frames_.back().scopes.emplace_back();
-        struct Pop {
-            std::vector<Frame>& f;
-            ~Pop() { f.pop_back(); }
-        } pop{frames_};
-        return box_expected ? expected_box(e) : expr(e);
+        return in_closed_frame(ctx, [&] { return box_expected ? expected_box(e) : expr(e); });
     }
 
     // Where a box is expected (`over`, enclose's box), `*` between intervals is the ASCII spelling of
     // The box a × b of an interval or box `a` and an interval `b`.
     Value box_product(const Value& a, const Value& b, Location loc) {
+        box_product_rule(a.type(), b.type(), loc);
         Value r;
         r.kind = ValueKind::box;
         r.box = a.box;
         r.box.push_back(b.box[0]);
-        if (r.box.size() > 3) fail(loc, "boxes have 2 or 3 axes");
         return r;
     }
 
@@ -270,75 +249,27 @@ private:
         if (e.kind == ExprKind::binary && e.op == Tok::star) {
             const Value a = expected_box(*e.kids[0]);
             const Value b = expr(*e.kids[1]);
-            if ((a.kind == ValueKind::interval || a.kind == ValueKind::box) && b.kind == ValueKind::interval)
-                return box_product(a, b, e.loc);
+            if (is_box_product(a.type(), b.type())) return box_product(a, b, e.loc);
         }
         return expr(e);
     }
 
     // Inlines a function or shape body; `ctx` is what the body may use (a shape's body never runs queries).
     Value inline_body(const Item& it, Scope params, Location call_loc, Context ctx) {
-        for (const Item* active : call_stack_)
-            if (active == &it)
-                fail(call_loc,
-                     fmt::format("recursive call of '{}': functions are inlined, so recursion is not "
-                                 "supported (write a series instead)",
-                                 it.name));
         // A body sees its parameters and the globals; series levels continue from the caller's.
         const int level = frames_.empty() ? 0 : frames_.back().level;
-        // A shape's own definition is no call: no note for it.
-        const bool is_call = call_loc.line != it.loc.line || call_loc.column != it.loc.column;
-        return inline_expr(*it.body, Frame{ctx, {std::move(params)}, level}, &it, call_loc,
-                           is_call ? fmt::format("in this call of '{}'", it.name) : std::string());
-    }
-
-    // Elaborates an inlined body in its own frame; `item` is null for an anonymous function. An error in
-    // the body gets a note at the call (`call_note`, unless empty).
-    Value inline_expr(const Expr& body, Frame frame, const Item* item, Location call_loc,
-                      const std::string& call_note) {
-        if (static_cast<int>(call_stack_.size()) >= limits_.max_inline_depth)
-            fail(call_loc, fmt::format("calls nested deeper than the limit of {}", limits_.max_inline_depth));
-        frames_.push_back(std::move(frame));
-        call_stack_.push_back(item);
-        struct Pop {
-            std::vector<Frame>& f;
-            std::vector<const Item*>& s;
-            ~Pop() {
-                f.pop_back();
-                s.pop_back();
-            }
-        } pop{frames_, call_stack_};
-        try {
-            return expr(body);
-        } catch (CompileError& e) {
-            constexpr std::size_t max_call_notes = 8;
-            if (!call_note.empty() && e.notes.size() < max_call_notes)
-                e.notes.emplace_back(call_loc, call_note);
-            throw;
-        }
-    }
-
-    const Value* lookup_local(const std::string& name) const {
-        const Frame& f = frames_.back();
-        for (auto s = f.scopes.rbegin(); s != f.scopes.rend(); ++s)
-            for (auto b = s->rbegin(); b != s->rend(); ++b)
-                if (b->first == name) return &b->second;
-        return nullptr;
+        return in_call_frame(Frame{ctx, {std::move(params)}, level}, &it, call_loc, call_note(it, call_loc),
+                             [&] { return expr(*it.body); });
     }
 
     // ---- expressions ----
     NodeId scalar(const Value& v, Location loc) {
-        if (v.shape) fail(loc, "a shape is not a number here; call it with coordinates");
-        if (v.function || v.builtin || v.closure)
-            fail(loc, "a function is not a number here; call it with arguments");
+        require_number(v.type(), loc);
         if (v.kind == ValueKind::interval) return g_.constant(v.box[0], num::midpoint(v.box[0]));
-        if (v.kind != ValueKind::scalar)
-            fail(loc, fmt::format("expected a number, found {}", kind_name(v.kind)));
         return v.nodes[0];
     }
     NodeId boolean(const Value& v, Location loc) {
-        if (v.kind != ValueKind::boolean)
-            fail(loc, fmt::format("expected a condition, found {}", kind_name(v.kind)));
+        require_condition(v.type(), loc);
         return v.nodes[0];
     }
 
@@ -350,33 +281,18 @@ private:
         case ExprKind::unary: return unary(e);
         case ExprKind::binary: return binary(e);
         case ExprKind::if_: return if_expr(e);
-        case ExprKind::let: {
-            frames_.back().scopes.emplace_back();
-            for (const Binding& b : e.bindings) {
-                Value v = expr(*b.value);
-                frames_.back().scopes.back().emplace_back(b.name, std::move(v));
-            }
-            Value body = expr(*e.kids[0]);
-            frames_.back().scopes.pop_back();
-            return body;
-        }
+        case ExprKind::let: return let(e, [&](const Expr& x) { return expr(x); });
         case ExprKind::tuple: {
+            tuple_rule(e.kids.size(), e.loc);
             Value v;
             v.kind = ValueKind::point;
-            if (e.kids.size() > 3)
-                fail(e.loc, fmt::format("points have 2 or 3 coordinates, this one has {}", e.kids.size()));
             for (const ExprPtr& k : e.kids) v.nodes.push_back(scalar(expr(*k), k->loc));
             return v;
         }
         case ExprKind::field: {
             const Value p = expr(*e.kids[0]);
-            if (p.kind != ValueKind::point)
-                fail(e.loc, fmt::format("'.{}' needs a point, found {}", e.text, kind_name(p.kind)));
-            const std::size_t k = e.text == "x" ? 0 : e.text == "y" ? 1 : e.text == "z" ? 2 : 99;
-            if (k >= p.nodes.size())
-                fail(e.loc,
-                     fmt::format("a point of {} coordinates has no component '{}'", p.nodes.size(), e.text));
-            return Value::scalar(p.nodes[k]);
+            field_rule(p.type(), e.text, e.loc);
+            return Value::scalar(p.nodes[e.text == "x" ? 0 : e.text == "y" ? 1 : 2]);
         }
         case ExprKind::interval: {
             const NodeId lo = scalar(expr(*e.kids[0]), e.kids[0]->loc);
@@ -392,13 +308,14 @@ private:
             return r;
         }
         case ExprKind::series: return series(e);
+        case ExprKind::matrix: return matrix(e);
         case ExprKind::lambda: {
             Value v;
             v.closure = std::make_shared<const Closure>(Closure{&e, frames_.back().scopes});
             return v;
         }
         }
-        throw InternalError("elaborate: unknown expression kind");
+        throw InternalError("lower: unknown expression kind");
     }
 
     Value number(const Expr& e) {
@@ -417,9 +334,12 @@ private:
             const Item& it = *g->second;
             if (it.kind == ItemKind::const_) return const_value(it, e.loc);
             Value v;
-            (it.kind == ItemKind::shape ? v.shape : v.function) = &it;
+            (it.kind == ItemKind::shape       ? v.shape
+             : it.kind == ItemKind::automaton ? v.automaton
+                                              : v.function) = &it;
             return v;
         }
+        if (e.text == "identity") return linear_value(front::identity());
         if (e.text == "pi") return Value::scalar(g_.constant(num::pi(), M_PI));
         if (e.text == "e") return Value::scalar(g_.constant(num::e(), M_E));
         if (const Builtin* b = find_builtin(e.text)) {
@@ -441,7 +361,7 @@ private:
                 for (const Arg& a : e.args) args.push_back(expr(*a.value));
                 return call_closure(*f.closure, std::move(args), e.loc);
             }
-            fail(e.loc, fmt::format("'{}' is a value, not a function", e.text));
+            throw InternalError(fmt::format("'{}' is a value, not a function", e.text));
         }
         if (auto g = globals_.find(e.text); g != globals_.end()) return call_item(*g->second, e);
         const Builtin* b = find_builtin(e.text);
@@ -454,8 +374,8 @@ private:
         f.scopes.emplace_back();
         for (std::size_t i = 0; i < args.size(); ++i)
             f.scopes.back().emplace_back(c.lambda->bindings[i].name, std::move(args[i]));
-        return inline_expr(*c.lambda->kids[0], std::move(f), nullptr, call_loc,
-                           "in this call of the anonymous function");
+        return in_call_frame(std::move(f), nullptr, call_loc, "in this call of the anonymous function",
+                             [&] { return expr(*c.lambda->kids[0]); });
     }
 
     Value call_item(const Item& it, const Expr& e) {
@@ -489,72 +409,198 @@ private:
         case BuiltinKind::pow: return Value::scalar(power(arg(0), arg(1)));
         case BuiltinKind::enclose:
         case BuiltinKind::dimension: return query(e, *b);
+        case BuiltinKind::transform: {
+            std::vector<Entry> args;
+            for (const Arg& a : e.args) args.push_back(entry(expr(*a.value), a.loc));
+            if (e.text == "translate") return linear_value(translate(args));
+            if (e.text == "scale") return linear_value(scale(args));
+            if (e.text == "shear") return linear_value(shear(args[0], args[1]));
+            // rotate(angle): its cosine and sine folded as constants of the graph.
+            const NodeId angle = arg(0);
+            return linear_value(rotate(entry(Value::scalar(g_.op(Op::Cos, angle)), e.loc),
+                                       entry(Value::scalar(g_.op(Op::Sin, angle)), e.loc)));
+        }
+        case BuiltinKind::controls: {
+            std::vector<std::vector<Entry>> points;
+            for (const Arg& a : e.args) {
+                std::vector<Entry> p;
+                for (NodeId n : expr(*a.value).nodes) p.push_back(entry(Value::scalar(n), a.loc));
+                points.push_back(std::move(p));
+            }
+            return linear_value(LinearValue::matrix(controls(points)));
+        }
+        case BuiltinKind::primitive: break; // only after `primitive` (automaton_info)
         }
         throw InternalError("unknown builtin kind");
     }
 
+    // ---- operators and automata ----
+    static Value linear_value(LinearValue l) {
+        Value v;
+        v.linear = std::make_shared<const LinearValue>(std::move(l));
+        return v;
+    }
+
+    // A constant entry of an operator, exact when it folded exactly.
+    Entry entry(const Value& v, Location loc) {
+        const NodeId n = scalar(v, loc);
+        if (!g_.is_const(n)) fail(loc, "the entries of an operator must be constants");
+        Entry x;
+        if (const num::Rational* q = g_.exact_value(n)) x.exact = *q;
+        x.enclosure = g_[n].value;
+        if (!std::isfinite(x.enclosure.lo) || !std::isfinite(x.enclosure.hi))
+            fail(loc, "the entries of an operator must be finite");
+        return x;
+    }
+
+    Value matrix(const Expr& e) {
+        std::vector<std::vector<Entry>> rows;
+        for (const ExprPtr& row : e.kids) {
+            rows.emplace_back();
+            for (const ExprPtr& k : row->kids) rows.back().push_back(entry(expr(*k), k->loc));
+        }
+        return linear_value(LinearValue::matrix(operator_of(rows)));
+    }
+
+    Value linear_arithmetic(const Expr& e, const Value& a, const Value& b) {
+        const Location la = e.kids[0]->loc, lb = e.kids[1]->loc;
+        if (e.op == Tok::star && a.linear && b.linear) return linear_value(compose(*a.linear, *b.linear));
+        if (e.op == Tok::star && a.linear && b.kind == ValueKind::point) {
+            std::vector<std::vector<Entry>> column;
+            for (NodeId n : b.nodes) column.push_back({entry(Value::scalar(n), lb)});
+            const ir::Operator p = compose(a.linear->in(0), operator_of(column));
+            Value r;
+            r.kind = ValueKind::point;
+            for (std::size_t i = 0; i < p.rows(); ++i) {
+                const num::Interval v = p.enclosure(i, 0);
+                r.nodes.push_back(p.exact ? g_.constant((*p.exact)(i, 0)) : g_.constant(v, num::midpoint(v)));
+            }
+            return r;
+        }
+        if (e.op == Tok::star) {
+            const bool left = !a.linear; // number * matrix or matrix * number
+            return linear_value(LinearValue::matrix(
+                scale_by(entry(left ? a : b, left ? la : lb), (left ? b : a).linear->in(0))));
+        }
+        return linear_value(LinearValue::matrix(add(a.linear->in(0), b.linear->in(0), e.op == Tok::minus)));
+    }
+
+    // The operator of an arc, as a matrix from the space of `to` into the space of `from`.
+    ir::Operator arc_operator(const Value& v, const ir::Space& from) {
+        return v.linear->transform ? v.linear->in(from.dimension) : v.linear->in(0);
+    }
+
+    static ir::Space space_of(const SpaceDecl& s) {
+        return s.barycentric ? ir::Space::barycentric(s.n) : ir::Space::euclidean(s.n);
+    }
+
+    // What a state draws, as homogeneous columns of its space (the type checker checked the form).
+    ir::Primitive primitive_of(const StateDecl& s, const ir::Space& space) {
+        ir::Primitive p;
+        const Expr& e = *s.primitive;
+        if (e.kind == ExprKind::name) {
+            p.kind = ir::Primitive::Kind::shape;
+            p.shape = shape_info(*globals_.at(e.text));
+            return p;
+        }
+        p.kind = e.text == "point"     ? ir::Primitive::Kind::points
+                 : e.text == "polygon" ? ir::Primitive::Kind::polygon
+                                       : ir::Primitive::Kind::polyline;
+        const std::size_t n = static_cast<std::size_t>(space.coordinates());
+        if (e.args.empty()) { // a barycentric state: its vertices
+            p.points = num::Matrix<double>(n, n);
+            for (std::size_t i = 0; i < n; ++i) p.points(i, i) = 1;
+            return p;
+        }
+        p.points = num::Matrix<double>(n, e.args.size());
+        for (std::size_t c = 0; c < e.args.size(); ++c) {
+            const Value v = closed(*e.args[c].value, Context::constant);
+            for (std::size_t r = 0; r + 1 < n; ++r)
+                p.points(r, c) = num::midpoint(entry(Value::scalar(v.nodes[r]), e.args[c].loc).enclosure);
+            p.points(n - 1, c) = 1;
+        }
+        return p;
+    }
+
+    void automaton_info(const Item& it) {
+        const AutomatonDecl& decl = *it.automaton;
+        AutomatonInfo info;
+        info.name = it.name;
+        info.loc = it.loc;
+        ir::Automaton& a = info.automaton;
+        a.name = it.name;
+        const auto index = [&](const std::string& state) {
+            for (std::size_t i = 0; i < decl.states.size(); ++i)
+                if (decl.states[i].name == state) return i;
+            throw InternalError("an unresolved state");
+        };
+        for (const StateDecl& s : decl.states) {
+            ir::State st;
+            st.name = s.name;
+            st.space = space_of(s.space);
+            if (s.primitive) st.primitive = primitive_of(s, st.space);
+            a.states.push_back(std::move(st));
+            info.state_locs.push_back(s.loc);
+        }
+        for (const ArcDecl& d : decl.arcs) {
+            ir::Arc arc;
+            arc.from = index(d.from);
+            arc.to = index(d.to);
+            arc.label = d.label;
+            arc.op = arc_operator(closed(*d.op, Context::constant), a.states[arc.from].space);
+            if (d.probability) {
+                const Entry p = entry(closed(*d.probability, Context::constant), d.probability->loc);
+                if (!(p.enclosure.lo >= 0 && p.enclosure.hi <= 1))
+                    fail(d.probability->loc, "a probability is a number from 0 to 1");
+                arc.probability = p.exact ? p.exact->to_double() : num::midpoint(p.enclosure);
+            }
+            a.arcs.push_back(std::move(arc));
+            info.arc_locs.push_back(d.loc);
+        }
+        a.initial = decl.initial.empty() ? 0 : index(decl.initial);
+        if (decl.projection) a.projection = closed(*decl.projection, Context::constant).linear->in(0);
+        m_.automata.push_back(std::move(info));
+        automaton_index_[&it] = m_.automata.size() - 1;
+    }
+
     NodeId call_shape(const Item& it, const Expr& e) {
-        const std::size_t idx = shape_info(it);
-        const int dim = m_.shapes[idx].dimension;
-        std::vector<Value> coords;
+        shape_info(it);
+        std::vector<Value> coords; // the type checker checked their number
         if (e.args.size() == 1) {
-            const Value p = expr(*e.args[0].value);
-            if (p.kind != ValueKind::point || static_cast<int>(p.nodes.size()) != dim)
-                fail(e.args[0].loc,
-                     fmt::format("shape '{}' takes {} coordinates or a point of {}", it.name, dim, dim));
-            for (NodeId n : p.nodes) coords.push_back(Value::scalar(n));
+            for (NodeId n : expr(*e.args[0].value).nodes) coords.push_back(Value::scalar(n));
         } else {
-            if (static_cast<int>(e.args.size()) != dim)
-                fail(e.loc,
-                     fmt::format("shape '{}' takes {} coordinates, {} given", it.name, dim, e.args.size()));
             for (const Arg& a : e.args) coords.push_back(Value::scalar(scalar(expr(*a.value), a.loc)));
         }
         return shape_body(it, coords, e.loc);
     }
 
     Value query(const Expr& e, const Builtin& b) {
-        if (frames_.back().ctx != Context::test)
-            fail(e.loc,
-                 fmt::format("'{}' runs a computation on a shape; it is available in tests and print only",
-                             e.text));
+        // The type checker checked where queries are used and the types of their arguments.
         const Value s = expr(*e.args[0].value);
-        if (!s.shape) fail(e.args[0].loc, fmt::format("'{}' needs a shape as its first argument", e.text));
         Query q;
         q.loc = e.loc;
+        if (s.automaton) {
+            q.kind = Query::Kind::automaton_dimension;
+            q.shape = automaton_index_.at(s.automaton);
+            m_.queries.push_back(q);
+            return Value::scalar(g_.var(static_cast<int>(m_.queries.size() - 1)));
+        }
         q.shape = shape_info(*s.shape);
         const ShapeInfo& info = m_.shapes[q.shape];
         if (b.kind == BuiltinKind::enclose) {
-            const Value box = expected_box(*e.args[1].value);
-            if (box.kind != ValueKind::box)
-                fail(e.args[1].loc, fmt::format("'enclose' needs a box, found {}", kind_name(box.kind)));
-            if (static_cast<int>(box.box.size()) != info.dimension)
-                fail(e.args[1].loc, fmt::format("shape '{}' has {} coordinates, the box has {} axes",
-                                                info.name, info.dimension, box.box.size()));
             q.kind = Query::Kind::enclose;
-            q.box = box.box;
+            q.box = expected_box(*e.args[1].value).box;
         } else {
             q.kind = Query::Kind::dimension;
             q.box = info.box;
-            bool have_from = false, have_to = false;
             for (std::size_t i = 1; i < e.args.size(); ++i) {
                 const Arg& a = e.args[i];
                 std::int64_t v = 0;
                 const NodeId n = scalar(expr(*a.value), a.loc);
                 if (!g_.const_integer(n, v))
                     fail(a.loc, fmt::format("'{}:' needs an integer constant", a.name));
-                if (a.name == "from") {
-                    q.from = static_cast<int>(v);
-                    have_from = true;
-                } else if (a.name == "to") {
-                    q.to = static_cast<int>(v);
-                    have_to = true;
-                } else if (a.name == "split") {
-                    q.split = static_cast<int>(v);
-                } else {
-                    fail(a.loc, "'dimension' takes named arguments from:, to: and split:");
-                }
+                (a.name == "from" ? q.from : a.name == "to" ? q.to : q.split) = static_cast<int>(v);
             }
-            if (!have_from || !have_to) fail(e.loc, "'dimension' needs from: and to: levels");
             if (q.from < 0 || q.to <= q.from) fail(e.loc, "'dimension' needs 0 <= from < to");
         }
         m_.queries.push_back(q);
@@ -573,29 +619,23 @@ private:
 
     Value unary(const Expr& e) {
         const Value v = expr(*e.kids[0]);
-        switch (e.op) {
-        case Tok::kw_not: return Value::boolean(g_.op(Op::Not, boolean(v, e.kids[0]->loc)));
-        case Tok::plus:
-            if (v.kind == ValueKind::point) return v;
-            return Value::scalar(scalar(v, e.kids[0]->loc));
-        case Tok::minus:
-        case Tok::tilde: {
-            if (v.kind == ValueKind::point && e.op == Tok::minus) {
-                Value r = v;
-                for (NodeId& n : r.nodes) n = g_.op(Op::Neg, n);
-                return r;
-            }
-            return Value::scalar(g_.op(Op::Neg, scalar(v, e.kids[0]->loc)));
+        const Type t = unary_rule(e.op, v.type(), e.kids[0]->loc);
+        if (e.op == Tok::kw_not) return Value::boolean(g_.op(Op::Not, v.nodes[0]));
+        if (e.op == Tok::plus)
+            return t.kind == Type::Kind::point ? v : Value::scalar(scalar(v, e.kids[0]->loc));
+        if (t.kind == Type::Kind::point) {
+            Value r = v;
+            for (NodeId& n : r.nodes) n = g_.op(Op::Neg, n);
+            return r;
         }
-        default: break;
-        }
-        throw InternalError("unknown unary operator");
+        return Value::scalar(g_.op(Op::Neg, scalar(v, e.kids[0]->loc)));
     }
 
     Value binary(const Expr& e) {
         const Location la = e.kids[0]->loc, lb = e.kids[1]->loc;
         const Value a = expr(*e.kids[0]);
         const Value b = expr(*e.kids[1]);
+        binary_rule(e.op, a.type(), b.type(), e.loc, la, lb);
         switch (e.op) {
         case Tok::kw_and: return Value::boolean(g_.op(Op::And, boolean(a, la), boolean(b, lb)));
         case Tok::kw_or: return Value::boolean(g_.op(Op::Or, boolean(a, la), boolean(b, lb)));
@@ -608,13 +648,7 @@ private:
         case Tok::amp: return Value::scalar(g_.op(Op::Max, scalar(a, la), scalar(b, lb)));
         case Tok::bar: return Value::scalar(g_.op(Op::Min, scalar(a, la), scalar(b, lb)));
         case Tok::caret: return Value::scalar(power(scalar(a, la), scalar(b, lb)));
-        case Tok::times: {
-            if (a.kind != ValueKind::interval && a.kind != ValueKind::box)
-                fail(la, fmt::format("'×' builds a box from intervals, found {}", kind_name(a.kind)));
-            if (b.kind != ValueKind::interval)
-                fail(lb, fmt::format("'×' builds a box from intervals, found {}", kind_name(b.kind)));
-            return box_product(a, b, e.loc);
-        }
+        case Tok::times: return box_product(a, b, e.loc);
         case Tok::plus:
         case Tok::minus:
         case Tok::star:
@@ -630,19 +664,16 @@ private:
                       : e.op == Tok::star  ? Op::Mul
                                            : Op::Div;
         const Location la = e.kids[0]->loc, lb = e.kids[1]->loc;
+        if (a.linear || b.linear) return linear_arithmetic(e, a, b);
         const bool pa = a.kind == ValueKind::point, pb = b.kind == ValueKind::point;
         if (!pa && !pb) return Value::scalar(g_.op(op, scalar(a, la), scalar(b, lb)));
         Value r;
         r.kind = ValueKind::point;
-        if (pa && pb) {
-            if (op == Op::Mul || op == Op::Div) fail(e.loc, "points multiply or divide by numbers only");
-            if (a.nodes.size() != b.nodes.size()) fail(e.loc, "points of different dimensions");
+        if (pa && pb) { // the typing rule allows + and - of points of one dimension
             for (std::size_t i = 0; i < a.nodes.size(); ++i)
                 r.nodes.push_back(g_.op(op, a.nodes[i], b.nodes[i]));
             return r;
         }
-        if (op == Op::Add || op == Op::Sub) fail(e.loc, "a point and a number cannot be added; use a point");
-        if (pb && op == Op::Div) fail(e.loc, "a number cannot be divided by a point");
         const Value& p = pa ? a : b;
         const NodeId s = pa ? scalar(b, lb) : scalar(a, la);
         for (NodeId n : p.nodes) r.nodes.push_back(pa ? g_.op(op, n, s) : g_.op(op, s, n));
@@ -653,12 +684,7 @@ private:
         const NodeId c = boolean(expr(*e.kids[0]), e.kids[0]->loc);
         const Value a = expr(*e.kids[1]);
         const Value b = expr(*e.kids[2]);
-        if (a.kind == ValueKind::interval || a.kind == ValueKind::box || a.shape)
-            fail(e.kids[1]->loc, fmt::format("'if' chooses between numbers, points or conditions, found {}",
-                                             kind_name(a.kind)));
-        if (a.kind != b.kind || a.nodes.size() != b.nodes.size())
-            fail(e.kids[2]->loc,
-                 fmt::format("the branches of 'if' differ: {} and {}", kind_name(a.kind), kind_name(b.kind)));
+        if_rule(a.type(), b.type(), e.kids[1]->loc, e.kids[2]->loc);
         Value r = a;
         for (std::size_t i = 0; i < a.nodes.size(); ++i)
             r.nodes[i] = g_.op(Op::Select, c, a.nodes[i], b.nodes[i]);
@@ -701,7 +727,7 @@ private:
     }
 
     Value series(const Expr& e) {
-        const std::size_t frame = frames_.size() - 1; // frames_ grows while the body is elaborated
+        const std::size_t frame = frames_.size() - 1; // frames_ grows while the body is lowered
         auto integer = [&](const Expr& x, const char* what) {
             const NodeId n = scalar(expr(x), x.loc);
             std::int64_t v = 0;
@@ -747,19 +773,11 @@ private:
             if (e.kids.size() > 4) escape_radius = escape_radius_of(e, infinite);
             frames_[frame].scopes.emplace_back();
             frames_[frame].scopes.back().emplace_back(e.var, Value::scalar(g_.index(data.level)));
-            if (init.kind != ValueKind::point)
-                fail(e.kids[3]->loc,
-                     fmt::format("an orbit starts at a point, found {}", kind_name(init.kind)));
             data.state_count = static_cast<int>(init.nodes.size());
             Value state;
             state.kind = ValueKind::point;
             for (int c = 0; c < data.state_count; ++c) state.nodes.push_back(g_.state(data.level, c));
-            const Value* local_map = lookup_local(e.orbit_map); // a function parameter
-            if (local_map && !local_map->function && !local_map->closure)
-                fail(e.orbit_loc,
-                     fmt::format("the map of an orbit must be a function of a point defined with "
-                                 "'fn'; '{}' is bound to a builtin or a shape",
-                                 e.orbit_map));
+            const Value* local_map = lookup_local(e.orbit_map); // a function parameter (type checked)
             Value next;
             if (local_map && local_map->closure) {
                 next = call_closure(*local_map->closure, {state}, e.orbit_loc);
@@ -767,9 +785,6 @@ private:
                 const Item& map = local_map ? *local_map->function : *globals_.at(e.orbit_map);
                 next = inline_body(map, {{map.params[0].name, state}}, e.orbit_loc, frames_.back().ctx);
             }
-            if (next.kind != ValueKind::point || next.nodes.size() != state.nodes.size())
-                fail(e.orbit_loc, fmt::format("the map '{}' must return a point of {} coordinates",
-                                              e.orbit_map, state.nodes.size()));
             frames_[frame].scopes.back().emplace_back(e.orbit_var, state);
             orbit = init.nodes;
             orbit.insert(orbit.end(), next.nodes.begin(), next.nodes.end());
@@ -795,6 +810,7 @@ private:
     static constexpr std::size_t in_progress = static_cast<std::size_t>(-1);
     static constexpr std::size_t failed = static_cast<std::size_t>(-2);
     const Program& p_;
+    const TypedProgram& typed_;
     const SourceManager& sm_;
     Limits limits_;
     Module& m_;
@@ -802,17 +818,16 @@ private:
     Diagnostics& d_;
     std::unordered_map<std::string, const Item*> globals_;
     std::unordered_map<const Item*, std::size_t> shape_index_;
+    std::unordered_map<const Item*, std::size_t> automaton_index_;
     std::unordered_map<const Item*, std::optional<Value>> consts_;
     std::unordered_set<const Item*> failed_consts_;
-    std::vector<Frame> frames_;
-    std::vector<const Item*> call_stack_;
 };
 
 } // namespace
 
-void elaborate(const Program& program, const SourceManager& sources, const Limits& limits, Module& out,
-               Diagnostics& diags) {
-    Elaborator(program, sources, limits, out, diags).run();
+void lower(const Program& program, const TypedProgram& typed, const SourceManager& sources,
+           const Limits& limits, Module& out, Diagnostics& diags) {
+    Lowering(program, typed, sources, limits, out, diags).run();
 }
 
 } // namespace frac::front

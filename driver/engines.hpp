@@ -1,0 +1,30 @@
+// The evaluators of a model's expressions: the JIT by default, the interpreter as its fallback, or a
+// model compiled ahead of time and loaded ("aot").
+#pragma once
+
+#include "frontend/module.hpp"
+#include "ir/evaluator.hpp"
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+namespace frac::driver {
+
+struct EngineOptions {
+    std::string engine = "jit"; // or "interp" (the fallback when the JIT cannot be used), "aot"
+    ir::EvalOptions eval;
+    int threads = 0; // subdivision threads; 0: all cores
+};
+
+// A user-facing run-time failure (I/O, a computation that cannot be done): message and exit code 1.
+struct RunError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// An evaluator of the expression `root` reading `inputs` variables (a shape's coordinates, or the
+// answers of queries). When the JIT cannot be used, says why once on stderr and interprets.
+std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId root, int inputs,
+                                              const EngineOptions& options);
+
+} // namespace frac::driver
