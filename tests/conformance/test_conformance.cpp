@@ -158,7 +158,7 @@ TEMPLATE_TEST_CASE("empty coordinates give empty enclosures", "[conformance]", I
     CHECK(r.hi >= 3);
 }
 
-TEMPLATE_TEST_CASE("batches equal single evaluations; clones are independent", "[conformance]", InterpEngine,
+TEMPLATE_TEST_CASE("batches equal single evaluations, clones are independent", "[conformance]", InterpEngine,
                    JitEngine, AotEngine) {
     const Model m = compile("import \"fractals\";");
     auto e = shape_eval<TestType>(m, "triangle_stripes");
