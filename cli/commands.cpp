@@ -143,10 +143,6 @@ rt::RssResult cover(const std::vector<ir::Interval>& box, int depth, int split, 
     }
 }
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-    return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 } // namespace
 
 namespace {
@@ -262,6 +258,8 @@ int run_dimension(const std::string& file, const std::string& shape, int from, i
                   const EngineOptions& engine) {
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
+    if (const front::AutomatonInfo* a = c->module.find_automaton(shape))
+        return automaton_dimension(*a, from, to);
     const front::ShapeInfo& s = pick_shape(*c, shape);
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
     const rt::RssResult r = cover(s.box, to, split, false, engine.threads, *eval);

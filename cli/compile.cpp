@@ -30,10 +30,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-    return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 // A configured tool if it is there, else the same name looked up in PATH.
 std::string tool(const char* configured, const char* fallback) {
     std::error_code ec;

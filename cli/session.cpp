@@ -127,6 +127,10 @@ ConstantValue evaluate_constant(const std::string& text, const std::string& what
     return v;
 }
 
+bool ends_with(const std::string& s, const std::string& suffix) {
+    return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
 void check_output_writable(const std::string& path) {
     std::error_code ec;
     const bool existed = std::filesystem::exists(path, ec);

@@ -41,6 +41,8 @@ struct ConstantValue {
 };
 ConstantValue evaluate_constant(const std::string& text, const std::string& what);
 
+bool ends_with(const std::string& s, const std::string& suffix);
+
 // Throws UsageError when `path` cannot be written (checked before any work; leaves no file behind).
 void check_output_writable(const std::string& path);
 
