@@ -2,7 +2,6 @@
 #include "cli/commands.hpp"
 
 #include "driver/queries.hpp"
-#include "frontend/suggest.hpp"
 #include "runtime/automata/chaos.hpp"
 #include "runtime/automata/dimension.hpp"
 #include "runtime/automata/tree.hpp"
@@ -40,10 +39,7 @@ const front::AutomatonInfo& find_automaton(const front::Compilation& c, const st
     if (const front::AutomatonInfo* a = c.module.find_automaton(name)) return *a;
     std::vector<std::string> known;
     for (const auto& a : c.module.automata) known.push_back(a.name);
-    const auto near = front::closest_name(name, known);
-    throw UsageError(fmt::format("no ifs or cifs '{}' in the model{} (automata: {})", name,
-                                 near ? fmt::format("; did you mean '{}'?", *near) : "",
-                                 front::list_names(known)));
+    no_such_name("ifs or cifs", name, known, "automata");
 }
 
 int run_tree(const std::string& file, const TreeOptions& o) {
