@@ -1,0 +1,219 @@
+// Branch-and-bound distance to attractors (seed 000 sec. 2.3) against an independent reference.
+#include "attractor_systems.hpp"
+#include "runtime/automata/distance.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <random>
+
+using namespace frac;
+using rt::test::reference_distance;
+
+namespace {
+
+struct System {
+    const char* name;
+    ir::Automaton a;
+    double lo, hi; // square of test points
+    // Accuracy of the reference. The fern's slow contraction (0.85) makes the reference search
+    // (no witnesses at inner nodes until leaves) cost millions of nodes below 1e-5, so it is checked
+    // to 1e-4 there, to 1e-9 elsewhere.
+    double tol;
+};
+
+std::vector<System> systems() {
+    return {{"sierpinski", rt::test::sierpinski(), -0.5, 1.5, 1e-9},
+            {"fern", rt::test::fern(), -3, 3, 1e-4},
+            {"koch", rt::test::koch(), -0.3, 1.3, 1e-9},
+            {"two_state", rt::test::two_state(), -0.5, 1.5, 1e-9}};
+}
+
+// Epsilon no finer than the reference's accuracy.
+rt::AttractorDistance distance_for(const System& s) {
+    rt::DistanceOptions o;
+    o.epsilon = std::max(s.tol, 1e-6);
+    return rt::AttractorDistance(s.a, o);
+}
+
+} // namespace
+
+TEST_CASE("bounding balls and witnesses are found for every state", "[distance]") {
+    for (const System& s : systems()) {
+        INFO(s.name);
+        const std::vector<rt::StateBall> balls = rt::bounding_balls(s.a);
+        REQUIRE(balls.size() == s.a.states.size());
+        for (const rt::StateBall& b : balls) {
+            CHECK(b.radius > 0);
+            CHECK(b.witness_radius >= 0);
+            CHECK(b.witness_radius <= b.radius);
+        }
+        // Points of the initial attractor: images of the witness; each must be in the initial ball.
+        rt::AttractorDistance dist(s.a);
+        const rt::BruteForceResult bf = dist.brute_force(balls[s.a.initial].centre.data(), 6);
+        CHECK(bf.leaves > 0);
+    }
+}
+
+TEST_CASE("distance enclosures contain the reference distance at random points", "[distance]") {
+    std::mt19937_64 rng(7);
+    for (const System& s : systems()) {
+        INFO(s.name);
+        const rt::AttractorDistance dist = distance_for(s);
+        std::uniform_real_distribution<double> u(s.lo, s.hi);
+        for (int i = 0; i < 25; ++i) {
+            const double p[2] = {u(rng), u(rng)};
+            INFO(p[0] << ", " << p[1]);
+            const rt::DistanceResult r = dist.query(std::vector<num::Interval>{p[0], p[1]}.data());
+            const double ref = reference_distance(s.a, p[0], p[1], s.tol);
+            CHECK(r.converged);
+            CHECK(r.distance.lo <= ref + s.tol);
+            CHECK(r.distance.hi >= ref - s.tol);
+            CHECK(r.distance.hi - r.distance.lo <= dist.options().epsilon * 1.001);
+            CHECK(r.distance.lo >= 0);
+        }
+    }
+}
+
+TEST_CASE("box enclosures contain the reference distance of points of the box", "[distance]") {
+    std::mt19937_64 rng(11);
+    for (const System& s : systems()) {
+        INFO(s.name);
+        const rt::AttractorDistance dist = distance_for(s);
+        std::uniform_real_distribution<double> u(s.lo, s.hi), w(0.0, 0.2), t(0.0, 1.0);
+        for (int i = 0; i < 8; ++i) {
+            const double x0 = u(rng), y0 = u(rng), wx = w(rng), wy = w(rng);
+            const num::Interval box[2] = {{x0, x0 + wx}, {y0, y0 + wy}};
+            const num::Interval e = dist.eval_box(box);
+            double lo = 1e300, hi = 0;
+            for (int k = 0; k < 7; ++k) {
+                const double fx = k < 4    ? (k & 1)
+                                  : k == 4 ? 0.5
+                                           : t(rng),
+                             fy = k < 4    ? (k >> 1)
+                                  : k == 4 ? 0.5
+                                           : t(rng);
+                const double ref = reference_distance(s.a, x0 + fx * wx, y0 + fy * wy, s.tol);
+                lo = std::min(lo, ref), hi = std::max(hi, ref);
+            }
+            INFO("box " << x0 << " " << y0 << " " << wx << " " << wy << " -> [" << e.lo << ", " << e.hi
+                        << "]");
+            CHECK(e.lo <= lo + s.tol);
+            CHECK(e.hi >= hi - s.tol);
+            // Not vacuous: within the box's diagonal of the sampled range.
+            const double diag = std::hypot(wx, wy);
+            CHECK(e.lo >= lo - diag - 2 * s.tol - 1e-6);
+            CHECK(e.hi <= hi + diag + 2 * s.tol + 1e-6);
+        }
+    }
+}
+
+TEST_CASE("points on the attractor have lower bound 0", "[distance]") {
+    rt::DistanceOptions o;
+    o.epsilon = 1e-7;
+    const rt::AttractorDistance dist(rt::test::sierpinski(), o);
+    // Dyadic points of the triangle's edges and of inner edges are on the attractor.
+    for (auto [x, y] :
+         {std::pair{0.0, 0.0}, {1.0, 0.0}, {0.25, 0.0}, {0.5, 0.5}, {0.25, 0.25}, {0.375, 0.125}}) {
+        const double p[2] = {x, y};
+        const num::Interval e = dist.eval_point(p);
+        INFO(x << ", " << y << " -> [" << e.lo << ", " << e.hi << "]");
+        CHECK(e.lo == 0);
+        CHECK(e.hi <= 1e-7);
+    }
+    // Points of the fern from its own maps (fixed point of f2 composed with f3), within rounding.
+    const ir::Automaton fern = rt::test::fern();
+    const rt::AttractorDistance fd(fern, o);
+    double x = 0, y = 0;
+    for (int i = 0; i < 2000; ++i) { // a chaos-game stream, deterministic order
+        const auto& n =
+            fern.arcs[static_cast<std::size_t>(1 + (i * 7 % 11 == 0 ? 1 : 0) + (i % 13 == 0 ? 1 : 0))]
+                .op.nearest;
+        const double nx = n(0, 0) * x + n(0, 1) * y + n(0, 2), ny = n(1, 0) * x + n(1, 1) * y + n(1, 2);
+        x = nx, y = ny;
+        if (i % 400 == 399) {
+            const double p[2] = {x, y};
+            const num::Interval e = fd.eval_point(p);
+            CHECK(e.lo <= 1e-12);
+            CHECK(e.hi <= 1e-7);
+        }
+    }
+}
+
+TEST_CASE("a barycentric state with a projection gives the euclidean system's distances", "[distance]") {
+    const rt::AttractorDistance bary(rt::test::sierpinski_bary());
+    const rt::AttractorDistance eucl(rt::test::sierpinski());
+    CHECK(bary.dimension() == 2);
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(-0.5, 1.5);
+    for (int i = 0; i < 30; ++i) {
+        const double p[2] = {u(rng), u(rng)};
+        const num::Interval a = bary.eval_point(p), b = eucl.eval_point(p);
+        CHECK(a.lo <= b.hi);
+        CHECK(b.lo <= a.hi);
+        CHECK(a.hi - a.lo <= 1e-6 * 1.001);
+    }
+}
+
+TEST_CASE("the widths reach epsilon; a small node budget leaves a wider but proven interval", "[distance]") {
+    const ir::Automaton fern = rt::test::fern();
+    const double p[2] = {1.0, 5.0};
+    const double ref = reference_distance(fern, p[0], p[1], 1e-4);
+    for (double eps : {1e-2, 1e-4, 1e-8}) {
+        rt::DistanceOptions o;
+        o.epsilon = eps;
+        const rt::DistanceResult r =
+            rt::AttractorDistance(fern, o).query(std::vector<num::Interval>{1.0, 5.0}.data());
+        CHECK(r.converged);
+        CHECK(r.distance.hi - r.distance.lo <= eps * 1.001);
+        CHECK(r.distance.lo <= ref + 1e-4);
+        CHECK(r.distance.hi >= ref - 1e-4);
+    }
+    rt::DistanceOptions o;
+    o.epsilon = 1e-9;
+    o.max_nodes = 5;
+    const rt::DistanceResult r =
+        rt::AttractorDistance(fern, o).query(std::vector<num::Interval>{1.0, 5.0}.data());
+    CHECK_FALSE(r.converged);
+    CHECK(r.nodes <= 5);
+    CHECK(r.distance.lo <= ref + 1e-4);
+    CHECK(r.distance.hi >= ref - 1e-4);
+}
+
+TEST_CASE("eq. 2 brute force agrees with branch and bound within its error", "[distance]") {
+    const ir::Automaton sier = rt::test::sierpinski();
+    const rt::AttractorDistance dist(sier);
+    const int level = dist.brute_force_level(1e-3);
+    CHECK(level > 5);
+    CHECK(level < 14);
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(-0.5, 1.5);
+    for (int i = 0; i < 5; ++i) {
+        const double p[2] = {u(rng), u(rng)};
+        const rt::BruteForceResult bf = dist.brute_force(p, level);
+        CHECK(bf.error <= 1e-3);
+        CHECK(bf.leaves == static_cast<std::uint64_t>(std::pow(3, level)));
+        const num::Interval e = dist.eval_point(p);
+        CHECK(bf.estimate - bf.error <= e.hi);
+        CHECK(bf.estimate + bf.error >= e.lo);
+    }
+}
+
+TEST_CASE("bad automata give clear errors", "[distance]") {
+    // Expanding map: no bounding ball.
+    ir::Automaton big =
+        rt::test::ifs("big", {rt::test::affine2(2, 0, 0, 2, 0, 0),
+                              rt::test::affine2(num::Rational(1, 2), 0, 0, num::Rational(1, 2), 1, 0)});
+    CHECK_THROWS_WITH(rt::AttractorDistance(big), Catch::Contains("contract"));
+    // A state without arcs: empty attractor.
+    ir::Automaton empty;
+    empty.name = "empty";
+    empty.states.push_back({"s", ir::Space::euclidean(2), {}});
+    CHECK_THROWS_WITH(rt::AttractorDistance(empty), Catch::Contains("empty"));
+    // A non-affine operator.
+    ir::Automaton bad = rt::test::ifs(
+        "bad", {ir::Operator::from_exact(num::Matrix<num::Rational>{{1, 0, 0}, {0, 1, 0}, {1, 0, 1}})});
+    CHECK_THROWS_WITH(rt::AttractorDistance(bad), Catch::Contains("affine"));
+    rt::DistanceOptions o;
+    o.epsilon = 0;
+    CHECK_THROWS_AS(rt::AttractorDistance(rt::test::sierpinski(), o), std::invalid_argument);
+}
