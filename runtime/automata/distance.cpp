@@ -668,49 +668,50 @@ DistanceResult AttractorDistance::query(const Interval* box) const {
 
 BruteForceResult AttractorDistance::brute_force(const double* p, int level) const {
     if (level < 0 || level > 40) throw std::invalid_argument("brute force level must be in 0..40");
-    const std::size_t d = static_cast<std::size_t>(dim_);
+    const std::size_t d = static_cast<std::size_t>(dim_), depth_count = static_cast<std::size_t>(level) + 1;
     BruteForceResult out;
     out.estimate = num::inf;
-    struct Frame {
-        std::size_t state;
-        int depth;
-        double lip;
-        std::vector<double> m; // d x coords
-    };
-    std::vector<Frame> stack;
-    {
-        Frame f{initial_, 0, root_lip_, std::vector<double>(root_.size())};
-        for (std::size_t i = 0; i < root_.size(); ++i) f.m[i] = num::midpoint(root_[i]);
-        stack.push_back(std::move(f));
-    }
-    while (!stack.empty()) {
-        Frame f = std::move(stack.back());
-        stack.pop_back();
-        const std::size_t n = states_[f.state].coords;
-        if (f.depth == level) {
-            const StateBall& b = balls_[f.state];
+    // Depth-first over the paths, one composite per depth (no allocation per node).
+    std::size_t stride = 0;
+    for (const StateData& s : states_) stride = std::max(stride, d * s.coords);
+    std::vector<double> mats(depth_count * stride), lips(depth_count);
+    std::vector<std::size_t> state(depth_count), next(depth_count, 0);
+    for (std::size_t i = 0; i < root_.size(); ++i) mats[i] = num::midpoint(root_[i]);
+    state[0] = initial_, lips[0] = root_lip_;
+    for (std::ptrdiff_t depth = 0; depth >= 0;) {
+        const std::size_t k = static_cast<std::size_t>(depth);
+        const std::size_t n = states_[state[k]].coords;
+        const double* m = &mats[k * stride];
+        if (k + 1 == depth_count) {
+            const StateBall& b = balls_[state[k]];
             double s = 0;
             for (std::size_t i = 0; i < d; ++i) {
                 double x = 0;
-                for (std::size_t j = 0; j < n; ++j) x += f.m[i * n + j] * b.centre[j];
+                for (std::size_t j = 0; j < n; ++j) x += m[i * n + j] * b.centre[j];
                 s += (p[i] - x) * (p[i] - x);
             }
             out.estimate = std::min(out.estimate, std::sqrt(s));
-            out.error = std::max(out.error, f.lip * b.radius);
+            out.error = std::max(out.error, lips[k] * b.radius);
             ++out.leaves;
+            --depth;
             continue;
         }
-        for (std::size_t ai : states_[f.state].arcs) {
-            const ArcData& arc = arcs_[ai];
-            const std::size_t k = states_[arc.to].coords;
-            Frame c{arc.to, f.depth + 1, f.lip * arc.lip, std::vector<double>(d * k, 0.0)};
-            for (std::size_t i = 0; i < d; ++i)
-                for (std::size_t l = 0; l < n; ++l) {
-                    const double v = f.m[i * n + l];
-                    for (std::size_t j = 0; j < k; ++j) c.m[i * k + j] += v * arc.nearest[l * k + j];
-                }
-            stack.push_back(std::move(c));
+        if (next[k] >= states_[state[k]].arcs.size()) {
+            next[k] = 0;
+            --depth;
+            continue;
         }
+        const ArcData& arc = arcs_[states_[state[k]].arcs[next[k]++]];
+        const std::size_t c = states_[arc.to].coords;
+        double* child = &mats[(k + 1) * stride];
+        for (std::size_t i = 0; i < d; ++i)
+            for (std::size_t j = 0; j < c; ++j) {
+                double v = 0;
+                for (std::size_t l = 0; l < n; ++l) v += m[i * n + l] * arc.nearest[l * c + j];
+                child[i * c + j] = v;
+            }
+        state[k + 1] = arc.to, lips[k + 1] = lips[k] * arc.lip, next[k + 1] = 0;
+        ++depth;
     }
     return out;
 }
