@@ -80,6 +80,22 @@ inline ir::Automaton koch() {
                         affine2i(third, z, z, third, num::div(2.0, 3.0), z)});
 }
 
+// Sierpinski tetrahedron in R3: x/2 + v/2 for the vertices v = 0, e1, e2, e3.
+inline ir::Automaton tetrahedron() {
+    ir::Automaton a;
+    a.name = "tetrahedron";
+    a.states.push_back({"t", ir::Space::euclidean(3), {}});
+    const Rational h(1, 2);
+    for (int v = 0; v < 4; ++v) {
+        num::Matrix<Rational> m(4, 4);
+        for (std::size_t i = 0; i < 3; ++i) m(i, i) = h;
+        m(3, 3) = 1;
+        if (v > 0) m(static_cast<std::size_t>(v - 1), 3) = h;
+        a.arcs.push_back({0, 0, ir::Operator::from_exact(m), std::nullopt, ""});
+    }
+    return a;
+}
+
 // Two states: A = a(A) u b(B), B = c(A) u e(B), with different maps, so the states' attractors differ.
 inline ir::Automaton two_state() {
     ir::Automaton a;

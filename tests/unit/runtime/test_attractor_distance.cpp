@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <random>
+#include <thread>
 
 using namespace frac;
 using rt::test::reference_distance;
@@ -216,4 +217,40 @@ TEST_CASE("bad automata give clear errors", "[distance]") {
     rt::DistanceOptions o;
     o.epsilon = 0;
     CHECK_THROWS_AS(rt::AttractorDistance(rt::test::sierpinski(), o), std::invalid_argument);
+}
+
+TEST_CASE("distances in R3 and from several threads", "[distance]") {
+    rt::DistanceOptions o;
+    o.epsilon = 1e-8;
+    const rt::AttractorDistance dist(rt::test::tetrahedron(), o);
+    CHECK(dist.dimension() == 3);
+    const double origin[3] = {0, 0, 0}, out[3] = {-1, -1, -1}, mid[3] = {0.5, 0.5, 0};
+    CHECK(dist.eval_point(origin).lo == 0);
+    CHECK(dist.eval_point(mid).lo == 0);
+    // The nearest point is the vertex 0 (the attractor lies in the positive octant). A point facing a
+    // face instead would need ever more nodes: every node within epsilon of the distance is refined.
+    const num::Interval e = dist.eval_point(out);
+    CHECK(e.lo <= std::sqrt(3.0));
+    CHECK(e.hi >= std::sqrt(3.0));
+    CHECK(e.hi - e.lo <= 1e-8 * 1.001);
+
+    // One const object queried from two threads gives the answers of one thread.
+    rt::DistanceOptions fo;
+    fo.epsilon = 1e-4;
+    const rt::AttractorDistance fern(rt::test::fern(), fo);
+    std::vector<std::array<double, 2>> ps;
+    std::mt19937_64 rng(9);
+    std::uniform_real_distribution<double> u(-3, 3);
+    for (int i = 0; i < 60; ++i) ps.push_back({u(rng), u(rng) + 4});
+    std::vector<num::Interval> serial, a(ps.size()), b(ps.size());
+    for (const auto& p : ps) serial.push_back(fern.eval_point(p.data()));
+    std::thread t1([&] {
+        for (std::size_t i = 0; i < ps.size(); ++i) a[i] = fern.eval_point(ps[i].data());
+    });
+    std::thread t2([&] {
+        for (std::size_t i = ps.size(); i-- > 0;) b[i] = fern.eval_point(ps[i].data());
+    });
+    t1.join(), t2.join();
+    CHECK(a == serial);
+    CHECK(b == serial);
 }
