@@ -425,10 +425,9 @@ AttractorCoverResult automaton_attractor_cover(const ir::Automaton& a, const std
             first.push_back(out.size());
         }
     };
-    // Vertices of states not reached by the initial one only cost time; keep every state for
-    // simplicity (graph-directed systems are small).
-    std::vector<Grid> g = grids;
-    return build(d, g, a.initial, images, options);
+    // Vertices of states the initial one does not reach have no images, so they are transient after
+    // the first graph and cost nothing later.
+    return build(d, grids, a.initial, images, options);
 }
 
 } // namespace frac::rt

@@ -449,6 +449,8 @@ AttractorDistance::AttractorDistance(const ir::Automaton& a, DistanceOptions opt
     if (!(options_.epsilon > 0) || !std::isfinite(options_.epsilon))
         throw std::invalid_argument("distance epsilon must be positive");
     if (options_.max_nodes == 0) throw std::invalid_argument("distance node budget must be positive");
+    if (!(options_.box_tolerance >= 0) || !std::isfinite(options_.box_tolerance))
+        throw std::invalid_argument("distance box tolerance must be finite and >= 0");
     balls_ = bounding_balls(a);
     if (balls_[a.initial].radius < 0)
         throw std::invalid_argument(fmt::format("the attractor of automaton '{}' is empty (no path from its "
@@ -513,7 +515,13 @@ DistanceResult AttractorDistance::query(const Interval* box) const {
         if (box[i].lo != box[i].hi) point = false;
     }
     num::UpwardRounding up;
-    const double eps = options_.epsilon;
+    double eps = options_.epsilon;
+    if (!point) {
+        Interval diag2(0.0);
+        for (std::size_t i = 0; i < d; ++i)
+            diag2 = num::add(diag2, num::sqr(num::sub(Interval(box[i].hi), Interval(box[i].lo))));
+        eps = std::max(eps, options_.box_tolerance * num::sqrt(diag2).lo);
+    }
 
     // Composite matrices (d x coords of the node's state) live in a pool of fixed-size slots,
     // recycled once a node is expanded.

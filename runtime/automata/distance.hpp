@@ -47,8 +47,11 @@ std::vector<StateBall> bounding_balls(const ir::Automaton& a);
 double spectral_norm_upper(const std::vector<Interval>& m, std::size_t rows, std::size_t cols);
 
 struct DistanceOptions {
-    double epsilon = 1e-6;             // stop when upper - lower <= epsilon (for a box: see eval_box)
-    std::uint64_t max_nodes = 1000000; // nodes expanded per query; the result stays proven, only wider
+    double epsilon = 1e-6;            // stop when upper - lower <= epsilon (for a box: see eval_box)
+    std::uint64_t max_nodes = 200000; // nodes expanded per query; the result stays proven, only wider
+    // For a box of diagonal D the lower end is refined to max(epsilon, box_tolerance * D) only: the
+    // upper end exceeds the minimum by up to D anyway (subdivision narrows boxes instead).
+    double box_tolerance = 0.125;
 };
 
 struct DistanceResult {
@@ -81,8 +84,9 @@ public:
     // An interval containing d(p, A).
     Interval eval_point(const double* p) const;
     // An interval containing d(p, A) for every p in the box (lower <= min, upper >= max). Refines
-    // until the lower bound of the minimum is within epsilon of an upper bound of the minimum; the
-    // upper end is the best witness bound of the maximum (at least the variation of d over the box).
+    // until the lower bound of the minimum is within epsilon (see box_tolerance) of an upper bound of
+    // the minimum; the upper end is the best witness bound of the maximum (at least the variation of
+    // d over the box).
     Interval eval_box(const Interval* box) const;
     // The same, with counters.
     DistanceResult query(const Interval* box) const;

@@ -1,11 +1,15 @@
 // Branch-and-bound distance to attractors (seed 000 sec. 2.3) against an independent reference.
 #include "attractor_systems.hpp"
 #include "runtime/automata/distance.hpp"
+#include "runtime/rss.hpp"
 
 #include <catch2/catch.hpp>
 
+#include <memory>
 #include <random>
+#include <set>
 #include <thread>
+#include <tuple>
 
 using namespace frac;
 using rt::test::reference_distance;
@@ -253,4 +257,57 @@ TEST_CASE("distances in R3 and from several threads", "[distance]") {
     t1.join(), t2.join();
     CHECK(a == serial);
     CHECK(b == serial);
+}
+
+namespace {
+
+// dist(p, A) - r as an evaluator, the way an expression engine would call the runtime.
+class Thickened : public ir::Evaluator {
+public:
+    Thickened(std::shared_ptr<const rt::AttractorDistance> d, double r) : d_(std::move(d)), r_(r) {}
+    int dimension() const override { return d_->dimension(); }
+    std::string engine() const override { return "test"; }
+    double eval_point(const double* p) override { return num::midpoint(d_->eval_point(p)) - r_; }
+    num::Interval eval_box(const num::Interval* box) override {
+        const num::Interval e = d_->eval_box(box);
+        num::UpwardRounding up;
+        return num::sub(e, num::Interval(r_));
+    }
+    std::unique_ptr<Evaluator> clone() const override { return std::make_unique<Thickened>(*this); }
+
+private:
+    std::shared_ptr<const rt::AttractorDistance> d_;
+    double r_;
+};
+
+} // namespace
+
+TEST_CASE("a subdivision of dist(p, A) - r never puts a chaos-game point outside", "[distance]") {
+    const ir::Automaton s = rt::test::sierpinski();
+    rt::DistanceOptions o;
+    o.epsilon = 1e-4;
+    Thickened f(std::make_shared<const rt::AttractorDistance>(s, o), 0.01);
+    rt::RssOptions ro;
+    ro.depth = 7;
+    const rt::RssResult cover = rt::subdivide(f, {{-0.25, 1.25}, {-0.25, 1.25}}, ro);
+    CHECK(cover.inside > 0);
+    CHECK(cover.outside > 0);
+    std::set<std::tuple<int, std::uint32_t, std::uint32_t>> outside;
+    for (const rt::Cell& c : cover.cells)
+        if (c.cls == rt::CellClass::outside) outside.insert({c.level, c.ix, c.iy});
+    std::mt19937_64 rng(8);
+    double x = 0.2, y = 0.2;
+    std::size_t wrong = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const auto& m = s.arcs[rng() % 3].op.nearest;
+        x = m(0, 0) * x + m(0, 2), y = m(1, 1) * y + m(1, 2);
+        if (i < 20) continue;
+        for (int level = 0; level <= ro.depth; ++level) {
+            const double n = static_cast<double>(cover.cells_per_axis(level));
+            const auto ix = static_cast<std::uint32_t>(std::floor((x + 0.25) / 1.5 * n));
+            const auto iy = static_cast<std::uint32_t>(std::floor((y + 0.25) / 1.5 * n));
+            if (outside.count({level, ix, iy})) ++wrong;
+        }
+    }
+    CHECK(wrong == 0);
 }
