@@ -311,3 +311,31 @@ TEST_CASE("a subdivision of dist(p, A) - r never puts a chaos-game point outside
     }
     CHECK(wrong == 0);
 }
+
+TEST_CASE("distance to the Cantor set in R1", "[distance]") {
+    ir::Automaton cantor;
+    cantor.name = "cantor";
+    cantor.states.push_back({"c", ir::Space::euclidean(1), {}});
+    for (int k : {0, 2})
+        cantor.arcs.push_back({0, 0,
+                               ir::Operator::from_exact(num::Matrix<num::Rational>{
+                                   {num::Rational(1, 3), num::Rational(k, 3)}, {0, 1}}),
+                               std::nullopt, ""});
+    rt::DistanceOptions o;
+    o.epsilon = 1e-9;
+    const rt::AttractorDistance dist(cantor, o);
+    CHECK(dist.dimension() == 1);
+    // The middle third's centre is 1/6 from 1/3 and 2/3; 1/4 is in the set (0.0202... in base 3).
+    const double half = 0.5, quarter = 0.25, left = -1;
+    const num::Interval a = dist.eval_point(&half), b = dist.eval_point(&quarter), c = dist.eval_point(&left);
+    CHECK(a.lo <= 1.0 / 6 + 1e-15);
+    CHECK(a.hi >= 1.0 / 6 - 1e-15);
+    CHECK(a.hi - a.lo <= 1e-9);
+    CHECK(b.lo == 0);
+    CHECK(b.hi <= 1e-9);
+    CHECK(c.contains(1.0));
+    const num::Interval box{0.4, 0.45}; // min 1/3 away: 0.4 - 1/3; max 0.45 - 1/3
+    const num::Interval e = dist.eval_box(&box);
+    CHECK(e.lo <= 0.4 - 1.0 / 3);
+    CHECK(e.hi >= 0.45 - 1.0 / 3);
+}
