@@ -170,16 +170,18 @@ AttractorCoverResult build(int d, const std::vector<Grid>& grids, std::size_t in
             const num::UpwardRounding again; // evaluators may have changed the rounding mode
             for (std::size_t c = 0; c < cells.size(); ++c) {
                 for (std::size_t m = first[c]; m < first[c + 1]; ++m) {
-                    const Image& img = imgs[m];
+                    Image& img = imgs[m];
                     const Grid& g = grids[img.state];
                     // Candidate index range per axis (one cell of margin; the exact test follows).
                     std::array<std::uint64_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
                     bool empty = false;
                     for (int a = 0; a < d; ++a) {
-                        const Interval b = img.box[static_cast<std::size_t>(a)];
+                        Interval& b = img.box[static_cast<std::size_t>(a)];
                         const Interval r = g.root[static_cast<std::size_t>(a)];
-                        if (b.is_empty() || std::isnan(b.lo) || std::isnan(b.hi) || b.hi < r.lo ||
-                            b.lo > r.hi) {
+                        // A NaN bound says nothing: the image may reach anywhere along this axis.
+                        if (std::isnan(b.lo)) b.lo = -num::inf;
+                        if (std::isnan(b.hi)) b.hi = num::inf;
+                        if (b.is_empty() || b.hi < r.lo || b.lo > r.hi) {
                             empty = true;
                             break;
                         }

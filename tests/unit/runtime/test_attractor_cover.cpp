@@ -261,6 +261,37 @@ TEST_CASE("a cover in R3: the Sierpinski tetrahedron", "[cover]") {
     CHECK(e.dimension > 2.0);
 }
 
+namespace {
+// An engine that cannot bound its value: NaN bounds (the cover must then assume any value).
+class Unknown : public ir::Evaluator {
+public:
+    int dimension() const override { return 2; }
+    std::string engine() const override { return "test"; }
+    double eval_point(const double*) override { return std::nan(""); }
+    num::Interval eval_box(const num::Interval*) override { return {std::nan(""), std::nan("")}; }
+    std::unique_ptr<Evaluator> clone() const override { return std::make_unique<Unknown>(); }
+};
+} // namespace
+
+TEST_CASE("a component with NaN bounds keeps the cover sound", "[cover]") {
+    const PlaneMap h = compile_map(henon, {"hx", "hy"});
+    Unknown unknown;
+    rt::AttractorCoverOptions o;
+    o.initial_level = 5;
+    o.refinements = 2;
+    const rt::AttractorCoverResult c =
+        rt::map_attractor_cover({h.evaluators[0].get(), &unknown}, {{-1.5, 1.5}, {-0.5, 0.5}}, o);
+    const KeptCells kept(c);
+    double x = 0, y = 0;
+    std::size_t missed = 0;
+    for (int i = 0; i < 100000; ++i) {
+        const double nx = 1 + y - 1.4 * x * x;
+        y = 0.3 * x, x = nx;
+        if (i > 1000 && !kept.contains(x, y)) ++missed;
+    }
+    CHECK(missed == 0);
+}
+
 TEST_CASE("attractor covers report bad input and budgets", "[cover]") {
     const PlaneMap h = compile_map(henon, {"hx", "hy"});
     rt::AttractorCoverOptions o;
