@@ -509,6 +509,8 @@ DistanceResult AttractorDistance::query(const Interval* box) const {
     DistanceResult result;
     bool point = true;
     for (std::size_t i = 0; i < d; ++i) {
+        // NaN says nothing about the point: any distance. An empty box has no distances.
+        if (std::isnan(box[i].lo) || std::isnan(box[i].hi)) return {Interval(0.0, num::inf), 0, 0, false};
         if (box[i].is_empty()) return {Interval::empty(), 0, 0, true};
         if (!std::isfinite(box[i].lo) || !std::isfinite(box[i].hi))
             return {Interval(0.0, num::inf), 0, 0, false};

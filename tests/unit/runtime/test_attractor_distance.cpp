@@ -203,7 +203,7 @@ TEST_CASE("eq. 2 brute force agrees with branch and bound within its error", "[d
     }
 }
 
-TEST_CASE("bad automata give clear errors", "[distance]") {
+TEST_CASE("bad automata give clear errors, odd queries safe answers", "[distance]") {
     // Expanding map: no bounding ball.
     ir::Automaton big =
         rt::test::ifs("big", {rt::test::affine2(2, 0, 0, 2, 0, 0),
@@ -221,6 +221,13 @@ TEST_CASE("bad automata give clear errors", "[distance]") {
     rt::DistanceOptions o;
     o.epsilon = 0;
     CHECK_THROWS_AS(rt::AttractorDistance(rt::test::sierpinski(), o), std::invalid_argument);
+    // Odd queries: NaN or infinite coordinates give [0, inf], an empty box gives empty.
+    const rt::AttractorDistance d(rt::test::sierpinski());
+    const double nan_point[2] = {std::nan(""), 0.5};
+    CHECK(d.eval_point(nan_point) == num::Interval(0.0, num::inf));
+    const num::Interval wide[2] = {{0, num::inf}, {0, 1}}, none[2] = {num::Interval::empty(), {0, 1}};
+    CHECK(d.eval_box(wide) == num::Interval(0.0, num::inf));
+    CHECK(d.eval_box(none).is_empty());
 }
 
 TEST_CASE("distances in R3 and from several threads", "[distance]") {
