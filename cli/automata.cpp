@@ -2,10 +2,14 @@
 #include "cli/commands.hpp"
 
 #include "driver/queries.hpp"
+#include "frontend/lower.hpp"
+#include "runtime/automata/attractor_cover.hpp"
 #include "runtime/automata/chaos.hpp"
 #include "runtime/automata/dimension.hpp"
 #include "runtime/automata/tree.hpp"
 #include "runtime/dimension.hpp"
+#include "runtime/legend.hpp"
+#include "runtime/picture.hpp"
 
 #include <fmt/format.h>
 #include <iostream>
@@ -31,6 +35,21 @@ void check_picture_output(const std::string& path, bool svg_allowed) {
         throw UsageError(fmt::format("cannot tell the picture format of '{}': use .png{}", path,
                                      svg_allowed ? " or .svg" : ""));
     check_output_writable(path);
+}
+
+// The cover's picture, and how each graph of the refinement went.
+void write_cover(const rt::AttractorCoverResult& cover, const RenderOptions& o, const std::string& name) {
+    const rt::PictureKind kind = o.kind == "process" ? rt::PictureKind::process
+                                 : o.kind == "cover" ? rt::PictureKind::cover
+                                                     : rt::PictureKind::both;
+    if (ends_with(o.output, ".png"))
+        rt::write_png(rt::with_legend(rt::render(cover, kind, o.size), kind), o.output);
+    else
+        rt::write_svg(cover, o.output, kind);
+    for (const rt::CoverStep& s : cover.steps)
+        std::cout << fmt::format("level {:2}: {} cells, {} arcs, {} kept, area {:.6g}\n", s.level, s.cells,
+                                 s.arcs, s.kept, s.area);
+    std::cout << fmt::format("wrote {} (cell-graph cover of {})\n", o.output, name);
 }
 
 } // namespace
@@ -82,6 +101,80 @@ int run_chaos(const std::string& file, const ChaosCommandOptions& o) {
     rt::write_density_png(d, o.output);
     std::cout << fmt::format("wrote {} ({} points of {}, seed {}, over [{}, {}] × [{}, {}])\n", o.output,
                              d.recorded, a.name, o.seed, d.x0, d.x1, d.y0, d.y1);
+    return 0;
+}
+
+int render_automaton(const front::AutomatonInfo& info, const RenderOptions& o) {
+    const ir::Automaton& a = info.automaton;
+    if (o.output.empty())
+        throw UsageError("render of an automaton needs -o FILE.png (or .svg for --method tree)");
+    std::string method = o.method;
+    if (method.empty()) {
+        method = "chaos";
+        for (const ir::State& s : a.states)
+            if (s.primitive.kind != ir::Primitive::Kind::none) method = "tree";
+    }
+    if (method == "chaos" && ends_with(o.output, ".svg"))
+        throw UsageError("--method chaos draws a .png; .svg is for --method tree or cover");
+    if (method == "tree") {
+        if (o.depth > 24) throw UsageError("--depth of an evaluation tree is at most 24");
+        runtime_job([&] {
+            if (ends_with(o.output, ".svg"))
+                rt::write_tree_svg(a, o.depth, o.output);
+            else
+                rt::write_tree_png(a, o.depth, o.output, o.size);
+            return 0;
+        });
+        std::cout << fmt::format("wrote {} (evaluation tree of {} to depth {})\n", o.output, info.name,
+                                 o.depth);
+        return 0;
+    }
+    if (method == "chaos") {
+        rt::ChaosOptions co;
+        co.width = o.size;
+        co.points = static_cast<std::uint64_t>(o.size) * static_cast<std::uint64_t>(o.size) * 8;
+        const rt::Density d = runtime_job([&] { return rt::chaos_game(a, co); });
+        rt::write_density_png(d, o.output);
+        std::cout << fmt::format("wrote {} (chaos game of {}: {} points, seed {})\n", o.output, info.name,
+                                 d.recorded, co.seed);
+        return 0;
+    }
+    // A cover by cell graphs (seed 000 sec. 2.4) in the box of the attractor's proven bounding ball:
+    // grid level depth - 3, then 3 refinements of the kept cells.
+    if (o.depth < 3 || o.depth > 14) throw UsageError("--depth of an attractor cover is 3 to 14");
+    rt::AttractorCoverOptions co;
+    co.refinements = 3;
+    co.initial_level = o.depth - co.refinements;
+    write_cover(runtime_job([&] { return rt::automaton_attractor_cover(a, {}, co); }), o, info.name);
+    return 0;
+}
+
+int render_map(front::Compilation& c, const front::Item& map, const RenderOptions& o,
+               const EngineOptions& engine) {
+    if (o.output.empty()) throw UsageError("render of a map needs -o FILE.png or FILE.svg");
+    if (o.box.empty())
+        throw UsageError(fmt::format(
+            "the attractor of the map '{}' is covered inside a box: give --box x0:x1,y0:y1", map.name));
+    if (o.depth < 3 || o.depth > 14) throw UsageError("--depth of an attractor cover is 3 to 14");
+    const std::vector<ir::Interval> box = parse_box(o.box, 2);
+    std::vector<ir::NodeId> components;
+    try {
+        components = front::lower_point_map(c.program, c.typed, c.sources, {}, c.module, map, 2);
+    } catch (const front::CompileError& e) {
+        c.diags.error(e.loc, e.what());
+        std::cerr << c.diags.render(c.sources);
+        return front::exit_compile_error;
+    }
+    std::vector<std::unique_ptr<ir::Evaluator>> evaluators;
+    std::vector<ir::Evaluator*> parts;
+    for (ir::NodeId n : components) {
+        evaluators.push_back(make_evaluator(c.module, n, 2, engine));
+        parts.push_back(evaluators.back().get());
+    }
+    rt::AttractorCoverOptions co;
+    co.refinements = 3;
+    co.initial_level = o.depth - co.refinements;
+    write_cover(runtime_job([&] { return rt::map_attractor_cover(parts, box, co); }), o, map.name);
     return 0;
 }
 

@@ -191,6 +191,12 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
     if (!o.output.empty()) check_output_writable(o.output);
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
+    if (const front::AutomatonInfo* a = c->module.find_automaton(o.shape)) return render_automaton(*a, o);
+    for (const front::Item& it : c->program.items)
+        if (it.kind == front::ItemKind::fn && it.name == o.shape && !o.shape.empty())
+            return render_map(*c, it, o, engine);
+    if (!o.method.empty())
+        throw UsageError("--method is for automata (ifs, cifs); shapes are drawn from their cover");
     const front::ShapeInfo& s = pick_shape(*c, o.shape);
     // A 3D shape is drawn as a plane section (--slice) or as a shaded relief of its cover from above.
     int slice_axis = -1;

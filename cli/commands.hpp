@@ -9,7 +9,7 @@
 namespace frac::cli {
 
 struct RenderOptions {
-    std::string shape, box, output, kind = "both", ascii, slice;
+    std::string shape, box, output, kind = "both", ascii, slice, method;
     int depth = 8, split = 2, size = 512;
     bool force = false; // write an SVG over the size limit
 };
@@ -58,6 +58,12 @@ int run_chaos(const std::string& file, const ChaosCommandOptions& options);
 const front::AutomatonInfo& find_automaton(const front::Compilation& c, const std::string& name);
 // The similarity dimension with its proven bracket, or box counting of the chaos-game cover.
 int automaton_dimension(const front::AutomatonInfo& a, int from, int to);
+
+// frac render for an ifs or cifs (--method tree, chaos or cover).
+int render_automaton(const front::AutomatonInfo& a, const RenderOptions& options);
+// frac render for a map of the plane (fn henon(p) = ...): the cell-graph cover of its attractor in --box.
+int render_map(front::Compilation& c, const front::Item& map, const RenderOptions& options,
+               const EngineOptions& engine);
 
 // Runs the print statements (when `prints`) and the tests of each file; prints "N passed, N failed".
 int run_tests(const std::vector<std::string>& files, bool prints, const EngineOptions& engine);

@@ -61,7 +61,14 @@ int main(int argc, char** argv) {
     auto* render = app.add_subcommand(
         "render", "cover a shape by recursive subdivision and draw it (3D: a section or a shaded relief)");
     render->add_option("file", file, "model file")->required();
-    render->add_option("shape", render_options.shape, "shape name (default: the last shape of the file)");
+    render->add_option("shape", render_options.shape,
+                       "shape, ifs or cifs name (default: the last shape of the file)");
+    render
+        ->add_option("--method", render_options.method,
+                     "automata: tree (the primitives of the evaluation tree to --depth), chaos (the chaos "
+                     "game's density) or cover (a cover of the attractor by cells); default: tree when a "
+                     "state has a primitive, else chaos")
+        ->check(CLI::IsMember({"tree", "chaos", "cover"}));
     render->add_option("--depth", render_options.depth, "subdivision depth")
         ->check(CLI::Range(0, 64))
         ->capture_default_str();

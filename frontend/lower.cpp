@@ -81,12 +81,31 @@ public:
         : Inliner(limits.max_inline_depth), p_(p), typed_(typed), sm_(sm), limits_(limits), m_(m),
           g_(m.graph), d_(d) {}
 
-    void run() {
+    void declare() {
         for (const Item& it : p_.items) {
             if (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape ||
                 it.kind == ItemKind::automaton)
                 globals_[it.name] = &it;
         }
+    }
+
+    // The components of fn `map` (of one point) applied to the point (Var(0), ..., Var(d - 1)).
+    std::vector<NodeId> point_map(const Item& map, int dimension) {
+        Value p;
+        p.kind = ValueKind::point;
+        for (int k = 0; k < dimension; ++k) p.nodes.push_back(g_.var(k));
+        if (map.kind != ItemKind::fn || map.params.size() != 1)
+            fail(map.loc,
+                 fmt::format("'{}' is not a map of the plane: a map is a fn of one point", map.name));
+        const Value q = inline_body(map, {{map.params[0].name, p}}, map.loc, Context::shape);
+        if (q.kind != ValueKind::point || static_cast<int>(q.nodes.size()) != dimension)
+            fail(map.body->loc,
+                 fmt::format("the map '{}' must return a point of {} coordinates", map.name, dimension));
+        return q.nodes;
+    }
+
+    void run() {
+        declare();
         // Shapes first, in source order, so that tests can refer to any of them; then automata.
         for (const Item& it : p_.items)
             if (it.kind == ItemKind::shape && !typed_.failed.count(&it)) guarded([&] { shape_info(it); });
@@ -889,6 +908,15 @@ private:
 void lower(const Program& program, const TypedProgram& typed, const SourceManager& sources,
            const Limits& limits, Module& out, Diagnostics& diags) {
     Lowering(program, typed, sources, limits, out, diags).run();
+}
+
+std::vector<NodeId> lower_point_map(const Program& program, const TypedProgram& typed,
+                                    const SourceManager& sources, const Limits& limits, Module& out,
+                                    const Item& map, int dimension) {
+    Diagnostics unused; // errors are thrown as CompileError
+    Lowering lowering(program, typed, sources, limits, out, unused);
+    lowering.declare();
+    return lowering.point_map(map, dimension);
 }
 
 } // namespace frac::front
