@@ -37,6 +37,18 @@ void check_picture_output(const std::string& path, bool svg_allowed) {
     check_output_writable(path);
 }
 
+// The primitives of the evaluation tree's leaves, one colour per state (.svg: curves as polylines).
+void draw_tree(const ir::Automaton& a, int depth, const std::string& output, int size) {
+    runtime_job([&] {
+        if (ends_with(output, ".svg"))
+            rt::write_tree_svg(a, depth, output);
+        else
+            rt::write_tree_png(a, depth, output, size);
+        return 0;
+    });
+    std::cout << fmt::format("wrote {} (evaluation tree of {} to depth {})\n", output, a.name, depth);
+}
+
 // The cover's picture, and how each graph of the refinement went.
 void write_cover(const rt::AttractorCoverResult& cover, const RenderOptions& o, const std::string& name) {
     const rt::PictureKind kind = o.kind == "process" ? rt::PictureKind::process
@@ -74,14 +86,7 @@ int run_tree(const std::string& file, const TreeOptions& o) {
         });
         return 0;
     }
-    runtime_job([&] {
-        if (ends_with(o.output, ".svg"))
-            rt::write_tree_svg(a, o.depth, o.output);
-        else
-            rt::write_tree_png(a, o.depth, o.output, o.size);
-        return 0;
-    });
-    std::cout << fmt::format("wrote {} (evaluation tree of {} to depth {})\n", o.output, a.name, o.depth);
+    draw_tree(a, o.depth, o.output, o.size);
     return 0;
 }
 
@@ -118,15 +123,7 @@ int render_automaton(const front::AutomatonInfo& info, const RenderOptions& o) {
         throw UsageError("--method chaos draws a .png; .svg is for --method tree or cover");
     if (method == "tree") {
         if (o.depth > 24) throw UsageError("--depth of an evaluation tree is at most 24");
-        runtime_job([&] {
-            if (ends_with(o.output, ".svg"))
-                rt::write_tree_svg(a, o.depth, o.output);
-            else
-                rt::write_tree_png(a, o.depth, o.output, o.size);
-            return 0;
-        });
-        std::cout << fmt::format("wrote {} (evaluation tree of {} to depth {})\n", o.output, info.name,
-                                 o.depth);
+        draw_tree(a, o.depth, o.output, o.size);
         return 0;
     }
     if (method == "chaos") {
