@@ -14,6 +14,7 @@
 #include "backend/llvm/box_codegen.hpp"
 
 #include "backend/llvm/helpers.hpp"
+#include "backend/llvm/skeleton.hpp"
 #include "ir/graph.hpp"
 #include "ir/series_tail.hpp"
 
@@ -62,17 +63,14 @@ struct SlotState {
     Interval k;
 };
 
-class BoxGen {
+class BoxGen : public Skeleton<BoxGen, SlotState> {
+    friend class Skeleton<BoxGen, SlotState>;
+
 public:
     BoxGen(const Tape& t, const ir::EvalOptions& o, const Tables& tab, llvm::Module& m, std::string name,
            Rounding rounding, int lanes)
-        : t_(t), o_(o), tab_(tab), m_(m), ctx_(m.getContext()), name_(std::move(name)), b_(m.getContext()),
-          avx512_(rounding == Rounding::avx512), w_(lanes) {
+        : Skeleton(t, o, tab, m, std::move(name), lanes), avx512_(rounding == Rounding::avx512) {
         if (avx512_ && w_ != 1 && w_ != 8) throw std::logic_error("jit: AVX-512 rounding needs 1 or 8 lanes");
-        dbl_ = Type::getDoubleTy(ctx_);
-        i64_ = Type::getInt64Ty(ctx_);
-        i32_ = Type::getInt32Ty(ctx_);
-        ptr_ = llvm::PointerType::get(ctx_, 0);
         vt_ =
             w_ == 1 ? dbl_ : static_cast<Type*>(llvm::FixedVectorType::get(dbl_, static_cast<unsigned>(w_)));
         mt_ = w_ == 1 ? Type::getInt1Ty(ctx_)
@@ -80,7 +78,6 @@ public:
                             llvm::FixedVectorType::get(Type::getInt1Ty(ctx_), static_cast<unsigned>(w_)));
         vi64_ =
             w_ == 1 ? i64_ : static_cast<Type*>(llvm::FixedVectorType::get(i64_, static_cast<unsigned>(w_)));
-        pair_ = llvm::StructType::get(ctx_, {dbl_, dbl_});
         if (!avx512_) {
             b_.setIsFPConstrained(true);
             b_.setDefaultConstrainedRounding(llvm::RoundingMode::TowardPositive);
@@ -88,31 +85,12 @@ public:
         }
     }
 
-    std::string run() {
-        const std::string fname = name_ + "_box";
-        auto* fty = llvm::FunctionType::get(Type::getVoidTy(ctx_), {ptr_, i64_, ptr_, ptr_}, false);
-        Function* f = Function::Create(fty, llvm::GlobalValue::ExternalLinkage, fname, m_);
-        f->setDoesNotThrow();
-        for (unsigned k : {0u, 2u, 3u}) {
-            f->addParamAttr(k, llvm::Attribute::NoAlias);
-            f->addParamAttr(k, llvm::Attribute::NoCapture);
-        }
-        f->addParamAttr(0, llvm::Attribute::ReadOnly);
+private:
+    // ---- the skeleton's hooks ----
+    void prepare(Function* f) {
         if (!avx512_) f->addFnAttr(llvm::Attribute::StrictFP);
-        fn_ = f;
-        Value* in = f->getArg(0);
-        Value* n = f->getArg(1);
-        Value* out = f->getArg(2);
-        Value* stats = f->getArg(3);
-
-        BasicBlock* entry = BasicBlock::Create(ctx_, "entry", f);
-        BasicBlock* loop = BasicBlock::Create(ctx_, "boxes", f);
-        BasicBlock* done = BasicBlock::Create(ctx_, "done", f);
-        b_.SetInsertPoint(entry);
-        terms_ = b_.CreateAlloca(i64_, nullptr, "terms");
-        capped_ = b_.CreateAlloca(i64_, nullptr, "capped");
-        b_.CreateStore(b_.getInt64(0), terms_);
-        b_.CreateStore(b_.getInt64(0), capped_);
+    }
+    void allocate() {
         // Scratch memory of the helpers, aligned for whole-vector loads and stores.
         auto aligned = [&](Type* t, const char* what) {
             llvm::AllocaInst* a = b_.CreateAlloca(t, nullptr, what);
@@ -134,17 +112,14 @@ public:
             esc_out_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(4 * w_)), "eout");
             esc_h_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(w_)), "eh");
         }
-        b_.CreateCondBr(b_.CreateICmpEQ(n, b_.getInt64(0)), done, loop);
-
-        // One iteration per group of W boxes; lanes past the end repeat the last box and are not stored.
-        b_.SetInsertPoint(loop);
-        llvm::PHINode* k = b_.CreatePHI(i64_, 2, "k");
-        k->addIncoming(b_.getInt64(0), entry);
-        Value* first_box = b_.CreateMul(k, b_.getInt64(static_cast<std::uint64_t>(w_)));
+    }
+    // One iteration per group of W boxes; lanes past the end repeat the last box and are not stored.
+    void load_inputs(Value* in, Value* n, Value* k) {
+        first_box_ = b_.CreateMul(k, b_.getInt64(static_cast<std::uint64_t>(w_)));
         Value* last_box = b_.CreateSub(n, b_.getInt64(1));
         std::vector<Value*> box_of_lane(static_cast<std::size_t>(w_));
         for (int j = 0; j < w_; ++j) {
-            Value* bj = b_.CreateAdd(first_box, b_.getInt64(static_cast<std::uint64_t>(j)));
+            Value* bj = b_.CreateAdd(first_box_, b_.getInt64(static_cast<std::uint64_t>(j)));
             box_of_lane[static_cast<std::size_t>(j)] =
                 j == 0 ? bj : b_.CreateSelect(b_.CreateICmpULT(bj, n), bj, last_box);
         }
@@ -152,24 +127,14 @@ public:
             ctx_mask_ = b_.getTrue();
         } else {
             Value* lanes =
-                b_.CreateAdd(b_.CreateVectorSplat(static_cast<unsigned>(w_), first_box), lane_numbers());
+                b_.CreateAdd(b_.CreateVectorSplat(static_cast<unsigned>(w_), first_box_), lane_numbers());
             ctx_mask_ = b_.CreateICmpULT(lanes, b_.CreateVectorSplat(static_cast<unsigned>(w_), n));
-        }
-
-        states_.assign(t_.num_slots, SlotState{});
-        idx_.assign(t_.series.size(), nullptr);
-        for (const ir::TapeConst& c : t_.constants) {
-            SlotState& s = states_[c.slot];
-            s.known = true;
-            s.k = c.value;
-            s.v = {cst(c.value.lo), cst(c.value.hi)};
-            s.f = facts_of(&c.value, 1);
         }
         const auto d = static_cast<std::uint64_t>(t_.inputs);
         for (std::size_t j = 0; j < t_.input_slots.size(); ++j) {
             const Slot s = t_.input_slots[j];
             if (s == ir::no_slot) continue;
-            SlotState& st = states_[s];
+            SlotState& st = vals_[s];
             for (int half = 0; half < 2; ++half) {
                 Value* v = w_ == 1 ? nullptr : static_cast<Value*>(llvm::PoisonValue::get(vt_));
                 for (int l = 0; l < w_; ++l) {
@@ -184,31 +149,57 @@ public:
             }
             st.f = tab_.slot_facts[s]; // not empty: boxes with an empty coordinate go to the interpreter
         }
-
-        emit_block(0);
-
-        const IV r = states_[t_.result].v;
+    }
+    void store_result(Value* out, Value* n, Value*) {
+        const IV r = vals_[t_.result].v;
         for (int l = 0; l < w_; ++l) {
-            Value* bj = b_.CreateAdd(first_box, b_.getInt64(static_cast<std::uint64_t>(l)));
+            Value* bj = b_.CreateAdd(first_box_, b_.getInt64(static_cast<std::uint64_t>(l)));
             Value* at = b_.CreateInBoundsGEP(dbl_, out, b_.CreateMul(bj, b_.getInt64(2)));
             if (l > 0) at = b_.CreateSelect(b_.CreateICmpULT(bj, n), at, sink_);
             b_.CreateStore(lane(r.lo, l), at);
             b_.CreateStore(lane(r.hi, l), b_.CreateInBoundsGEP(dbl_, at, b_.getInt64(1)));
         }
-        Value* k1 = b_.CreateAdd(k, b_.getInt64(1));
-        k->addIncoming(k1, b_.GetInsertBlock());
-        b_.CreateCondBr(b_.CreateICmpUGE(b_.CreateMul(k1, b_.getInt64(static_cast<std::uint64_t>(w_))), n),
-                        done, loop);
-
-        b_.SetInsertPoint(done);
-        add_stat(stats, 0, n);
-        add_stat(stats, 1, b_.CreateLoad(i64_, terms_));
-        add_stat(stats, 2, b_.CreateLoad(i64_, capped_));
-        b_.CreateRetVoid();
-        return fname;
     }
-
-private:
+    SlotState constant(const ir::TapeConst& c) {
+        SlotState s;
+        s.known = true;
+        s.k = c.value;
+        s.v = {cst(c.value.lo), cst(c.value.hi)};
+        s.f = facts_of(&c.value, 1);
+        return s;
+    }
+    SlotState indexed(const IndexTable& it, Value* idx) {
+        return from_table(load_pair(table(&it.box, it.box, "index"), idx), it.facts);
+    }
+    SlotState operation(const Instr& ins) {
+        SlotState r = emit_op(ins);
+        r.f = tab_.slot_facts[ins.out];
+        return r;
+    }
+    SlotState series(const Instr& ins) {
+        SlotState r = emit_series(ins);
+        r.f = tab_.slot_facts[ins.out];
+        return r;
+    }
+    SlotState carry(const SlotState& init, BasicBlock* pre, Slot slot) {
+        llvm::PHINode* lo = b_.CreatePHI(vt_, 2, "state.lo");
+        llvm::PHINode* hi = b_.CreatePHI(vt_, 2, "state.hi");
+        lo->addIncoming(init.v.lo, pre);
+        hi->addIncoming(init.v.hi, pre);
+        SlotState sc;
+        sc.v = {lo, hi};
+        sc.f = tab_.slot_facts[slot];
+        return sc;
+    }
+    void carry_next(const SlotState& phis, const SlotState& next, BasicBlock* latch) {
+        llvm::cast<llvm::PHINode>(phis.v.lo)->addIncoming(next.v.lo, latch);
+        llvm::cast<llvm::PHINode>(phis.v.hi)->addIncoming(next.v.hi, latch);
+    }
+    SlotState index_value(const SeriesLoop& L) {
+        const bool exact = std::max(std::fabs(static_cast<double>(L.start)),
+                                    std::fabs(static_cast<double>(L.last))) < 0x1p52;
+        return thin(splat(index_to_double(L.i, exact)));
+    }
     // ---- lanes, masks and constants ----
     Value* cst(double x) { return llvm::ConstantFP::get(vt_, x); }
     Value* i1(bool v) { return llvm::ConstantInt::get(mt_, v ? 1 : 0); }
@@ -232,14 +223,6 @@ private:
     Value* mask_bits(Value* mask) {
         return b_.CreateZExt(b_.CreateBitCast(mask, b_.getIntNTy(static_cast<unsigned>(w_))), i32_);
     }
-    void add_stat(Value* stats, int field, Value* v) {
-        Value* p = b_.CreateInBoundsGEP(i64_, stats, b_.getInt64(static_cast<std::uint64_t>(field)));
-        b_.CreateStore(b_.CreateAdd(b_.CreateLoad(i64_, p), v), p);
-    }
-    void bump(Value* counter, Value* by) {
-        b_.CreateStore(b_.CreateAdd(b_.CreateLoad(i64_, counter), by), counter);
-    }
-
     // ---- floating point, rounded upward ----
     static constexpr int ru_sae = 2 | 8; // _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC
     Value* x86_round(llvm::Intrinsic::ID scalar, llvm::Intrinsic::ID packed, Value* x, Value* y) {
@@ -656,7 +639,7 @@ private:
     }
 
     SlotState emit_op(const Instr& ins) {
-        auto in = [&](int k) -> const SlotState& { return states_[ins.in[static_cast<std::size_t>(k)]]; };
+        auto in = [&](int k) -> const SlotState& { return vals_[ins.in[static_cast<std::size_t>(k)]]; };
         switch (ins.op) {
         case Op::Add: return op_add(in(0), in(1));
         case Op::Sub: return op_sub(in(0), in(1));
@@ -674,7 +657,7 @@ private:
         case Op::Dz: return op_dz(in(0));
         case Op::Pow:
         case Op::Sqrt:
-        case Op::Log: return call_core(ins.op, 0, {&in(0), &in(arity(ins.op) > 1 ? 1 : 0)}, true);
+        case Op::Log: return call_core(ins.op, 0, {&in(0), &in(ir::arity(ins.op) > 1 ? 1 : 0)}, true);
         case Op::Sin:
         case Op::Cos:
         case Op::Tan:
@@ -700,30 +683,6 @@ private:
         case Op::SeriesMax: break;
         }
         throw std::logic_error(std::string("jit: not an operation: ") + ir::op_name(ins.op));
-    }
-    static int arity(Op op) { return ir::arity(op); }
-
-    // ---- tables ----
-    llvm::GlobalVariable* table(const void* key, const std::vector<double>& v, const char* what) {
-        if (auto it = globals_.find(key); it != globals_.end()) return it->second;
-        auto* init = llvm::ConstantDataArray::get(ctx_, llvm::ArrayRef<double>(v));
-        auto* g = new llvm::GlobalVariable(m_, init->getType(), true, llvm::GlobalValue::PrivateLinkage, init,
-                                           name_ + "." + what);
-        g->setUnnamedAddr(llvm::GlobalValue::UnnamedAddr::Global);
-        g->setAlignment(llvm::Align(16));
-        return globals_[key] = g;
-    }
-    llvm::GlobalVariable* table(const void* key, const std::vector<Interval>& v, const char* what) {
-        if (auto it = globals_.find(key); it != globals_.end()) return it->second;
-        std::vector<double> flat;
-        flat.reserve(2 * v.size());
-        for (const Interval& x : v) {
-            flat.push_back(x.lo);
-            flat.push_back(x.hi);
-        }
-        llvm::GlobalVariable* g = table(&flat, flat, what); // a fresh key: the temporary's address
-        globals_.erase(&flat);
-        return globals_[key] = g;
     }
     // Entry idx (a scalar, the same for every lane) of a table of doubles / of intervals.
     Value* load_scalar(llvm::GlobalVariable* g, Value* idx) {
@@ -813,7 +772,9 @@ private:
         return {d(e.radius),    d(e.slope),     d(e.offset),    d(e.scale0.lo),    d(e.scale0.hi),
                 d(e.growth.lo), d(e.growth.hi), d(e.lipschitz), d(e.map_lipschitz)};
     }
-    Value* mask_arg(Value* mask) { return w_ == 1 ? b_.getInt32(1) : mask_bits(mask); }
+    Value* mask_arg(Value* mask) {
+        return w_ == 1 ? b_.getInt32(1) : mask_bits(mask);
+    }
 
     // ir::lipschitz_centre of the initial point, lane by lane: the centres (replacing `init`) and h.
     Value* centre_orbit(std::vector<IV>& init, Value* mask) {
@@ -895,50 +856,33 @@ private:
     }
 
     SlotState emit_series(const Instr& ins) {
-        const TapeSeries& s = t_.series[ins.series];
-        const SeriesTables& st = tab_.series[ins.series];
-        const bool infinite = s.data.end == ir::infinite_end;
-        const bool has_b = s.tail_b != ir::no_slot;
-        const std::int64_t start = s.data.start;
-        const std::int64_t last = st.last;
-        const SlotState a = infinite ? states_[s.tail_a] : thin_known(0.0);
-        const SlotState bc = has_b ? states_[s.tail_b] : thin_known(0.0);
+        SeriesLoop L = series_loop(ins);
+        const TapeSeries& s = L.s;
+        const SeriesTables& st = L.st;
+        const bool infinite = L.infinite;
+        const bool has_b = L.has_b;
+        const SlotState a = infinite ? vals_[s.tail_a] : thin_known(0.0);
+        const SlotState bc = has_b ? vals_[s.tail_b] : thin_known(0.0);
         Value* outer_mask = ctx_mask_;
-        Value* start_v = b_.getInt64(static_cast<std::uint64_t>(start));
 
         // A proven Lipschitz bound: the orbit runs from the centre of the initial box (ir::lipschitz_centre).
-        std::vector<IV> init;
-        for (std::size_t c = 0; c < s.state_slots.size(); ++c) init.push_back(states_[s.init_slots[c]].v);
+        std::vector<IV> centre;
+        for (Slot c : s.init_slots) centre.push_back(vals_[c].v);
         const bool lipschitz = infinite && s.data.escape.present && s.data.escape.lipschitz > 0;
-        if (lipschitz) centre_orbit(init, outer_mask);
-        BasicBlock* pre = b_.GetInsertBlock();
-        BasicBlock* header = BasicBlock::Create(ctx_, "series", fn_);
-        BasicBlock* exit = BasicBlock::Create(ctx_, "series.exit", fn_);
-        b_.CreateBr(header);
-        b_.SetInsertPoint(header);
-        llvm::PHINode* i = b_.CreatePHI(i64_, 2, "i");
+        if (lipschitz) centre_orbit(centre, outer_mask);
+        std::vector<SlotState> init;
+        for (const IV& c : centre) init.push_back(result(c, false));
+        open_series(L, init);
+        Value* i = L.i;
+        BasicBlock* pre = L.pre;
         llvm::PHINode* acc_lo = b_.CreatePHI(vt_, 2, "acc.lo");
         llvm::PHINode* acc_hi = b_.CreatePHI(vt_, 2, "acc.hi");
         llvm::PHINode* active = b_.CreatePHI(mt_, 2, "active");
         llvm::PHINode* stop_at = b_.CreatePHI(vi64_, 2, "stop.at"); // the index after which a lane stopped
-        i->addIncoming(start_v, pre);
         acc_lo->addIncoming(cst(0.0), pre);
         acc_hi->addIncoming(cst(0.0), pre);
         active->addIncoming(outer_mask, pre);
-        stop_at->addIncoming(w_ == 1 ? start_v : b_.CreateVectorSplat(static_cast<unsigned>(w_), start_v),
-                             pre);
-        std::vector<std::pair<llvm::PHINode*, llvm::PHINode*>> state_phis; // orbit series: the point
-        for (std::size_t c = 0; c < s.state_slots.size(); ++c) {
-            llvm::PHINode* lo = b_.CreatePHI(vt_, 2, "state.lo");
-            llvm::PHINode* hi = b_.CreatePHI(vt_, 2, "state.hi");
-            lo->addIncoming(init[c].lo, pre);
-            hi->addIncoming(init[c].hi, pre);
-            state_phis.emplace_back(lo, hi);
-            SlotState sc;
-            sc.v = {lo, hi};
-            sc.f = tab_.slot_facts[s.state_slots[c]];
-            states_[s.state_slots[c]] = sc;
-        }
+        stop_at->addIncoming(splat(L.start_v), pre);
         const bool escape = infinite && s.data.escape.present;
         // Escape certificate: each lane's bound (around the centre) where it stopped, and the previous
         // term's bound of the orbit box (for the stalling rule).
@@ -950,20 +894,13 @@ private:
             esc_prev = b_.CreatePHI(vt_, 2, "esc.prev");
             esc_prev->addIncoming(cst(s.kind == Op::SeriesMax ? inf : -inf), pre);
         }
-        Value* idx = b_.CreateSub(i, start_v, "idx");
-        idx_[ins.series] = idx;
-        const bool exact =
-            std::max(std::fabs(static_cast<double>(start)), std::fabs(static_cast<double>(last))) < 0x1p52;
-        states_[s.index_slot] = thin(splat(index_to_double(i, exact)));
-
         ctx_mask_ = active;
-        emit_block(s.block);
+        series_body(L);
+        Value* idx = L.idx;
 
-        // The next orbit point, all components from this term's point (a map (p.y, p.x) swaps).
         std::vector<IV> next_state;
-        for (std::size_t c = 0; c < s.state_slots.size(); ++c)
-            next_state.push_back(states_[s.update_slots[c]].v);
-        const SlotState term = states_[s.body_slot];
+        for (const SlotState& c : L.next_state) next_state.push_back(c.v);
+        const SlotState term = L.term;
         // Escape certificate: the bound of the terms after i from the next orbit point.
         Value* esc_now = nullptr; // the bound from the orbit box
         Value* esc_far = nullptr; // the same for every orbit within the Lipschitz spread of it
@@ -971,29 +908,27 @@ private:
             std::tie(esc_now, esc_far) = escape_bound(s, next_state, b_.CreateAdd(i, b_.getInt64(1)), active);
         const SlotState acc = result({acc_lo, acc_hi}, term.f.maybe_empty);
         const SlotState comb = combine(s.kind, acc, term);
-        Value* first = splat(b_.CreateICmpEQ(i, start_v));
+        Value* first = splat(L.first);
         // Lanes that stopped keep their partial result.
         SlotState nacc =
             result({sel(first, term.v.lo, comb.v.lo), sel(first, term.v.hi, comb.v.hi)}, term.f.maybe_empty);
         if (w_ > 1) nacc.v = {sel(active, nacc.v.lo, acc_lo), sel(active, nacc.v.hi, acc_hi)};
         bump(terms_, count(active));
-        Value* is_last = b_.CreateICmpEQ(i, b_.getInt64(static_cast<std::uint64_t>(last)));
+        Value* is_last = L.is_last;
         // At the last index every active lane stops, capped by the term limit (infinite series).
-        Value* splat_i =
-            w_ == 1 ? static_cast<Value*>(i) : b_.CreateVectorSplat(static_cast<unsigned>(w_), i);
-        Value* last_at = w_ == 1 ? static_cast<Value*>(i) : b_.CreateSelect(active, splat_i, stop_at);
+        Value* splat_i = splat(i);
+        Value* last_at = w_ == 1 ? i : b_.CreateSelect(active, splat_i, stop_at);
         Value* esc_last = escape ? (w_ == 1 ? esc_far : sel(active, esc_far, esc_frozen)) : nullptr;
         Value* esc_next = esc_frozen;
         BasicBlock* from_last = b_.GetInsertBlock();
-        BasicBlock* latch = BasicBlock::Create(ctx_, "series.next", fn_);
         Value* still = active; // lanes that go on to the next term
         Value* stop_at_next = stop_at;
         BasicBlock* decided = nullptr; // the block that leaves when every lane stopped by a rule
         if (!infinite) {
-            b_.CreateCondBr(is_last, exit, latch);
+            b_.CreateCondBr(is_last, L.exit, L.latch);
         } else {
             BasicBlock* check = BasicBlock::Create(ctx_, "series.check", fn_);
-            b_.CreateCondBr(is_last, exit, check);
+            b_.CreateCondBr(is_last, L.exit, check);
             b_.SetInsertPoint(check);
             // 1. The term told little more than its static bound (ir::term_resolution).
             Value* stop1 = i1(false);
@@ -1006,7 +941,7 @@ private:
                     const SlotState gi = from_table(load_pair(table(&st.gamma_n, st.gamma_n, "gamma"), idx),
                                                     facts_of(st.gamma_n.data(), st.gamma_n.size()));
                     SlotState coeff = a;
-                    if (has_b) coeff = op_add(a, op_mul(bc, states_[s.index_slot]));
+                    if (has_b) coeff = op_add(a, op_mul(bc, vals_[s.index_slot]));
                     threshold = mul(cst(ir::term_resolution), width(op_mul(coeff, gi)));
                 }
                 stop1 = land(active, ge(width(term), threshold));
@@ -1066,28 +1001,21 @@ private:
             stop_at_next = b_.CreateSelect(stop, splat_i, stop_at);
             if (escape) esc_next = sel(stop, esc_far, esc_frozen);
             decided = b_.GetInsertBlock();
-            b_.CreateCondBr(any(still), latch, exit);
+            b_.CreateCondBr(any(still), L.latch, L.exit);
         }
-        b_.SetInsertPoint(latch);
-        Value* i_next = b_.CreateAdd(i, b_.getInt64(1));
-        b_.CreateBr(header);
-        i->addIncoming(i_next, latch);
-        acc_lo->addIncoming(nacc.v.lo, latch);
-        acc_hi->addIncoming(nacc.v.hi, latch);
-        active->addIncoming(still, latch);
-        stop_at->addIncoming(stop_at_next, latch);
+        acc_lo->addIncoming(nacc.v.lo, L.latch);
+        acc_hi->addIncoming(nacc.v.hi, L.latch);
+        active->addIncoming(still, L.latch);
+        stop_at->addIncoming(stop_at_next, L.latch);
         if (escape) {
-            esc_frozen->addIncoming(esc_next, latch);
-            esc_prev->addIncoming(esc_now, latch);
+            esc_frozen->addIncoming(esc_next, L.latch);
+            esc_prev->addIncoming(esc_now, L.latch);
         }
-        for (std::size_t c = 0; c < state_phis.size(); ++c) {
-            state_phis[c].first->addIncoming(next_state[c].lo, latch);
-            state_phis[c].second->addIncoming(next_state[c].hi, latch);
-        }
+        close_series(L);
 
         // Exit: at the last index (the active lanes are capped) or when every lane stopped by a rule.
-        b_.SetInsertPoint(exit);
         ctx_mask_ = outer_mask;
+        if (!infinite) return nacc;
         if (!infinite) return nacc;
         llvm::PHINode* capped_lanes = b_.CreatePHI(mt_, 2, "capped.lanes");
         llvm::PHINode* final_at = b_.CreatePHI(vi64_, 2, "final.at");
@@ -1102,8 +1030,7 @@ private:
             esc_final->addIncoming(esc_next, decided);
         }
         bump(capped_, count(capped_lanes));
-        Value* final_idx = b_.CreateSub(
-            final_at, w_ == 1 ? start_v : b_.CreateVectorSplat(static_cast<unsigned>(w_), start_v));
+        Value* final_idx = b_.CreateSub(final_at, splat(L.start_v));
         SlotState tail;
         if (st.const_tail)
             tail = from_table(gather_pair(table(&st.tail, st.tail, "tail"), final_idx),
@@ -1115,39 +1042,8 @@ private:
         return combine(s.kind, nacc, tail);
     }
 
-    void emit_block(std::uint32_t block) {
-        for (const Instr& ins : t_.blocks[block]) {
-            if (ir::is_series(ins.op)) {
-                states_[ins.out] = emit_series(ins);
-                states_[ins.out].f = tab_.slot_facts[ins.out];
-                continue;
-            }
-            const int tix = tab_.slot_table[ins.out];
-            if (tix >= 0) {
-                const IndexTable& it = tab_.index_tables[static_cast<std::size_t>(tix)];
-                states_[ins.out] =
-                    from_table(load_pair(table(&it.box, it.box, "index"), idx_[it.series]), it.facts);
-                continue;
-            }
-            states_[ins.out] = emit_op(ins);
-            states_[ins.out].f = tab_.slot_facts[ins.out];
-        }
-    }
-
-    const Tape& t_;
-    const ir::EvalOptions& o_;
-    const Tables& tab_;
-    llvm::Module& m_;
-    llvm::LLVMContext& ctx_;
-    std::string name_;
-    llvm::IRBuilder<> b_;
     bool avx512_;
-    int w_;
-    Type *dbl_, *i64_, *i32_, *ptr_, *vt_, *mt_, *vi64_;
-    llvm::StructType* pair_;
-    Function* fn_ = nullptr;
-    Value* terms_ = nullptr;
-    Value* capped_ = nullptr;
+    Type *vt_, *mt_, *vi64_;
     Value* scratch_in_ = nullptr;
     Value* scratch_n_ = nullptr;
     Value* scratch_out_ = nullptr;
@@ -1156,10 +1052,8 @@ private:
     Value* esc_out_ = nullptr;
     Value* esc_h_ = nullptr;
     Value* sink_ = nullptr;
-    Value* ctx_mask_ = nullptr; // lanes the current code computes for
-    std::vector<SlotState> states_;
-    std::vector<Value*> idx_;
-    std::map<const void*, llvm::GlobalVariable*> globals_;
+    Value* first_box_ = nullptr; // the iteration's first box
+    Value* ctx_mask_ = nullptr;  // lanes the current code computes for
 };
 
 } // namespace
@@ -1167,7 +1061,7 @@ private:
 std::string generate_box_function(const Tape& tape, const ir::EvalOptions& options, const Tables& tables,
                                   llvm::Module& module, const std::string& name, Rounding rounding,
                                   int lanes) {
-    return BoxGen(tape, options, tables, module, name, rounding, lanes).run();
+    return BoxGen(tape, options, tables, module, name, rounding, lanes).run("_box", "boxes");
 }
 
 } // namespace frac::jit
