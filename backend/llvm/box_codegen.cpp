@@ -106,8 +106,10 @@ private:
         }
         if (std::any_of(t_.series.begin(), t_.series.end(),
                         [](const TapeSeries& s) { return s.data.escape.present; })) {
-            // The escape helper: up to 8 orbit components in, one bound per lane out.
-            esc_in_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(16 * w_)), "ein");
+            // The escape helper: up to max_state_components orbit components in, one bound per lane out.
+            esc_in_ = aligned(
+                llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(2 * ir::max_state_components * w_)),
+                "ein");
             esc_n_ = aligned(llvm::ArrayType::get(i64_, static_cast<std::uint64_t>(w_)), "en");
             esc_out_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(4 * w_)), "eout");
             esc_h_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(w_)), "eh");
@@ -674,13 +676,8 @@ private:
         case Op::Or: return op_andor(in(0), in(1), false);
         case Op::Not: return op_not(in(0));
         case Op::Select: return op_select(in(0), in(1), in(2));
-        case Op::Const:
-        case Op::Var:
-        case Op::Index:
-        case Op::State:
-        case Op::SeriesSum:
-        case Op::SeriesMin:
-        case Op::SeriesMax: break;
+#include "ir/non_operation_cases.def"
+            break;
         }
         throw std::logic_error(std::string("jit: not an operation: ") + ir::op_name(ins.op));
     }

@@ -36,7 +36,8 @@ private:
     // ---- the skeleton's hooks ----
     void prepare(Function*) {}
     void allocate() {
-        escape_state_ = b_.CreateAlloca(llvm::ArrayType::get(dbl_, 8), nullptr, "escape.state");
+        escape_state_ =
+            b_.CreateAlloca(llvm::ArrayType::get(dbl_, ir::max_state_components), nullptr, "escape.state");
     }
     void load_inputs(Value* in, Value*, Value* k) {
         const auto d = static_cast<std::uint64_t>(t_.inputs);
@@ -125,13 +126,8 @@ private:
         case Op::Or: return bool_to_double(b_.CreateOr(half_true(in(0)), half_true(in(1))));
         case Op::Not: return bool_to_double(b_.CreateNot(half_true(in(0))));
         case Op::Select: return sel(half_true(in(0)), in(1), in(2));
-        case Op::Const:
-        case Op::Var:
-        case Op::Index:
-        case Op::State:
-        case Op::SeriesSum:
-        case Op::SeriesMin:
-        case Op::SeriesMax: break;
+#include "ir/non_operation_cases.def"
+            break;
         }
         throw std::logic_error(std::string("jit: not an operation: ") + ir::op_name(ins.op));
     }
