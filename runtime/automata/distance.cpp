@@ -494,6 +494,21 @@ AttractorDistance::AttractorDistance(const ir::Automaton& a, DistanceOptions opt
     }
 }
 
+std::vector<Interval> AttractorDistance::bounding_box() const {
+    const std::size_t d = static_cast<std::size_t>(dim_), n = states_[initial_].coords;
+    const StateBall& b = balls_[initial_];
+    num::UpwardRounding up;
+    const double r = up_mul(root_lip_, b.radius);
+    std::vector<Interval> box(d);
+    for (std::size_t i = 0; i < d; ++i) {
+        Interval c(0.0);
+        for (std::size_t j = 0; j < n; ++j)
+            c = num::add(c, num::mul(root_[i * n + j], Interval(b.centre[j])));
+        box[i] = {num::sub(Interval(c.lo), Interval(r)).lo, num::add(Interval(c.hi), Interval(r)).hi};
+    }
+    return box;
+}
+
 Interval AttractorDistance::eval_point(const double* p) const {
     std::vector<Interval> box(static_cast<std::size_t>(dim_));
     for (int i = 0; i < dim_; ++i) box[static_cast<std::size_t>(i)] = Interval(p[i]);

@@ -81,6 +81,10 @@ public:
     const DistanceOptions& options() const { return options_; }
     const std::vector<StateBall>& balls() const { return balls_; }
 
+    // A box of the output space holding the attractor (around its proven bounding ball), outward:
+    // a default box for pictures and covers.
+    std::vector<Interval> bounding_box() const;
+
     // An interval containing d(p, A).
     Interval eval_point(const double* p) const;
     // An interval containing d(p, A) for every p in the box (lower <= min, upper >= max). Refines

@@ -56,6 +56,18 @@ TEST_CASE("bounding balls and witnesses are found for every state", "[distance]"
         rt::AttractorDistance dist(s.a);
         const rt::BruteForceResult bf = dist.brute_force(balls[s.a.initial].centre.data(), 6);
         CHECK(bf.leaves > 0);
+        // The bounding box holds points of the attractor (an orbit under the initial state's loops).
+        const std::vector<num::Interval> box = dist.bounding_box();
+        REQUIRE(box.size() == 2);
+        double x = 0, y = 0;
+        for (int i = 0; i < 5000; ++i) { // a chaos game on the initial state's self-loops
+            const ir::Arc& arc = s.a.arcs[static_cast<std::size_t>(i * 7919) % s.a.arcs.size()];
+            if (arc.from != s.a.initial || arc.to != s.a.initial) continue;
+            const auto& m = arc.op.nearest;
+            const double nx = m(0, 0) * x + m(0, 1) * y + m(0, 2), ny = m(1, 0) * x + m(1, 1) * y + m(1, 2);
+            x = nx, y = ny;
+            if (i > 50) CHECK((box[0].contains(x) && box[1].contains(y)));
+        }
     }
 }
 
