@@ -143,10 +143,6 @@ rt::RssResult cover(const std::vector<ir::Interval>& box, int depth, int split, 
     }
 }
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-    return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 } // namespace
 
 namespace {
@@ -195,6 +191,12 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
     if (!o.output.empty()) check_output_writable(o.output);
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
+    if (const front::AutomatonInfo* a = c->module.find_automaton(o.shape)) return render_automaton(*a, o);
+    for (const front::Item& it : c->program.items)
+        if (it.kind == front::ItemKind::fn && it.name == o.shape && !o.shape.empty())
+            return render_map(*c, it, o, engine);
+    if (!o.method.empty())
+        throw UsageError("--method is for automata (ifs, cifs); shapes are drawn from their cover");
     const front::ShapeInfo& s = pick_shape(*c, o.shape);
     // A 3D shape is drawn as a plane section (--slice) or as a shaded relief of its cover from above.
     int slice_axis = -1;
@@ -262,6 +264,8 @@ int run_dimension(const std::string& file, const std::string& shape, int from, i
                   const EngineOptions& engine) {
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
+    if (const front::AutomatonInfo* a = c->module.find_automaton(shape))
+        return automaton_dimension(*a, from, to);
     const front::ShapeInfo& s = pick_shape(*c, shape);
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
     const rt::RssResult r = cover(s.box, to, split, false, engine.threads, *eval);

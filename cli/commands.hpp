@@ -9,7 +9,7 @@
 namespace frac::cli {
 
 struct RenderOptions {
-    std::string shape, box, output, kind = "both", ascii, slice;
+    std::string shape, box, output, kind = "both", ascii, slice, method;
     int depth = 8, split = 2, size = 512;
     bool force = false; // write an SVG over the size limit
 };
@@ -40,6 +40,31 @@ struct CompileOptions {
 // "" when `path` names an output frac compile can write (.o, .so, .ll), else why not.
 std::string check_compile_output(const std::string& path);
 int run_compile(const std::string& file, const CompileOptions& options);
+// ---- automata (cli/automata.cpp) ----
+struct TreeOptions {
+    std::string name, output; // no output: the text dump of the tree
+    int depth = 3, size = 1024;
+    bool matrices = true; // the dump shows each node's composite operator
+};
+// frac tree FILE NAME --depth n [-o FILE.png|FILE.svg]: the evaluation tree, one colour per state.
+int run_tree(const std::string& file, const TreeOptions& options);
+struct ChaosCommandOptions {
+    std::string name, output;
+    std::uint64_t points = 1'000'000, seed = 1;
+    int threads = 1, size = 512;
+};
+// frac chaos FILE NAME -n POINTS -o FILE.png: the chaos game's density, seeded and reproducible.
+int run_chaos(const std::string& file, const ChaosCommandOptions& options);
+const front::AutomatonInfo& find_automaton(const front::Compilation& c, const std::string& name);
+// The similarity dimension with its proven bracket, or box counting of the chaos-game cover.
+int automaton_dimension(const front::AutomatonInfo& a, int from, int to);
+
+// frac render for an ifs or cifs (--method tree, chaos or cover).
+int render_automaton(const front::AutomatonInfo& a, const RenderOptions& options);
+// frac render for a map of the plane (fn henon(p) = ...): the cell-graph cover of its attractor in --box.
+int render_map(front::Compilation& c, const front::Item& map, const RenderOptions& options,
+               const EngineOptions& engine);
+
 // Runs the print statements (when `prints`) and the tests of each file; prints "N passed, N failed".
 int run_tests(const std::vector<std::string>& files, bool prints, const EngineOptions& engine);
 

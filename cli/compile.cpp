@@ -20,10 +20,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-    return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 // Fails early, with the system's reason, when `path` cannot be written.
 void check_writable(const std::string& path) {
     std::ofstream probe(path, std::ios::binary | std::ios::app);

@@ -62,7 +62,14 @@ int main(int argc, char** argv) {
     auto* render = app.add_subcommand(
         "render", "cover a shape by recursive subdivision and draw it (3D: a section or a shaded relief)");
     render->add_option("file", file, "model file")->required();
-    render->add_option("shape", render_options.shape, "shape name (default: the last shape of the file)");
+    render->add_option("shape", render_options.shape,
+                       "shape, ifs or cifs name (default: the last shape of the file)");
+    render
+        ->add_option("--method", render_options.method,
+                     "automata: tree (the primitives of the evaluation tree to --depth), chaos (the chaos "
+                     "game's density) or cover (a cover of the attractor by cells); default: tree when a "
+                     "state has a primitive, else chaos")
+        ->check(CLI::IsMember({"tree", "chaos", "cover"}));
     render->add_option("--depth", render_options.depth, "subdivision depth")
         ->check(CLI::Range(0, 64))
         ->capture_default_str();
@@ -121,6 +128,34 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(2, 4))
         ->capture_default_str();
     add_engine(dimension);
+
+    cli::TreeOptions tree_options;
+    auto* tree = app.add_subcommand("tree", "the evaluation tree of an ifs or cifs: a text dump, or drawn");
+    tree->add_option("file", file, "model file")->required();
+    tree->add_option("name", tree_options.name, "ifs or cifs name")->required();
+    tree->add_option("--depth", tree_options.depth, "levels of the tree (0 to 24)")->capture_default_str();
+    tree->add_option("-o,--output", tree_options.output,
+                     "picture file: .png or .svg (curves as polylines); without it the tree is printed");
+    tree->add_option("--size", tree_options.size, "picture width and height in pixels")
+        ->capture_default_str();
+    bool tree_no_matrices = false;
+    tree->add_flag("--no-matrices", tree_no_matrices, "print the nodes' states and addresses only");
+    std::string tree_emit;
+    tree->add_option("--emit", tree_emit, "tree: print the text dump (the default without -o)")
+        ->check(CLI::IsMember({"tree"}));
+
+    cli::ChaosCommandOptions chaos_options;
+    auto* chaos = app.add_subcommand("chaos", "the chaos game of an ifs or cifs, as a density picture");
+    chaos->add_option("file", file, "model file")->required();
+    chaos->add_option("name", chaos_options.name, "ifs or cifs name")->required();
+    chaos->add_option("-n,--points", chaos_options.points, "points recorded")->capture_default_str();
+    chaos->add_option("-o,--output", chaos_options.output, "picture file (.png)")->required();
+    chaos->add_option("--seed", chaos_options.seed, "random seed: the same seed gives the same picture")
+        ->capture_default_str();
+    chaos->add_option("--threads", chaos_options.threads, "threads (the picture depends on their number)")
+        ->check(CLI::Range(1, 256))
+        ->capture_default_str();
+    chaos->add_option("--size", chaos_options.size, "picture width in pixels")->capture_default_str();
 
     std::vector<std::string> files;
     auto* test = app.add_subcommand("test", "run the test blocks of model files");
@@ -203,6 +238,13 @@ int main(int argc, char** argv) {
         if (*eval) return cli::run_eval(file, shape, at, box, engine);
         if (*render) return cli::run_render(file, render_options, engine);
         if (*dimension) return cli::run_dimension(file, shape, from, to, split, engine);
+        if (*tree) {
+            tree_options.matrices = !tree_no_matrices;
+            if (!tree_emit.empty() && !tree_options.output.empty())
+                throw cli::UsageError("--emit=tree prints the tree; -o draws it: give one of them");
+            return cli::run_tree(file, tree_options);
+        }
+        if (*chaos) return cli::run_chaos(file, chaos_options);
         if (*mesh) return cli::run_mesh(file, mesh_options, engine);
         if (*test) return cli::run_tests(files, false, engine);
         if (*compile) return cli::run_compile(file, compile_options);

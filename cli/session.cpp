@@ -60,14 +60,19 @@ std::unique_ptr<front::Compilation> compile_or_report(const std::string& path, d
     return c;
 }
 
+void no_such_name(const std::string& what, const std::string& name, const std::vector<std::string>& known,
+                  const std::string& kind_plural) {
+    const auto near = front::closest_name(name, known);
+    throw UsageError(fmt::format("no {} '{}' in the model{} ({}: {})", what, name,
+                                 near ? fmt::format("; did you mean '{}'?", *near) : "", kind_plural,
+                                 front::list_names(known)));
+}
+
 const front::ShapeInfo& find_shape(const front::Compilation& c, const std::string& name) {
     if (const front::ShapeInfo* s = c.module.find_shape(name)) return *s;
     std::vector<std::string> known;
     for (const auto& s : c.module.shapes) known.push_back(s.name);
-    const auto near = front::closest_name(name, known);
-    throw UsageError(fmt::format("no shape '{}' in the model{} (shapes: {})", name,
-                                 near ? fmt::format("; did you mean '{}'?", *near) : "",
-                                 front::list_names(known)));
+    no_such_name("shape", name, known, "shapes");
 }
 
 const front::ShapeInfo& pick_shape(const front::Compilation& c, const std::string& name) {
@@ -125,6 +130,10 @@ ConstantValue evaluate_constant(const std::string& text, const std::string& what
     if (v.enclosure.is_empty() || !std::isfinite(v.enclosure.lo) || !std::isfinite(v.enclosure.hi))
         throw UsageError(fmt::format("{} '{}' is not a finite number", what, text));
     return v;
+}
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+    return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 void check_output_writable(const std::string& path) {

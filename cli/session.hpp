@@ -41,9 +41,14 @@ struct ConstantValue {
 };
 ConstantValue evaluate_constant(const std::string& text, const std::string& what);
 
+bool ends_with(const std::string& s, const std::string& suffix);
+
 // Throws UsageError when `path` cannot be written (checked before any work; leaves no file behind).
 void check_output_writable(const std::string& path);
 
+// Throws the UsageError for an unknown name, with the nearest known one and the list.
+[[noreturn]] void no_such_name(const std::string& what, const std::string& name,
+                               const std::vector<std::string>& known, const std::string& kind_plural);
 const front::ShapeInfo& find_shape(const front::Compilation& c, const std::string& name);
 // The shape named, or the model's only/first shape when `name` is empty.
 const front::ShapeInfo& pick_shape(const front::Compilation& c, const std::string& name);

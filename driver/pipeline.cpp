@@ -203,7 +203,8 @@ std::string emit(const front::Compilation& c, Stage stage, const std::vector<std
     case Stage::automaton: {
         std::string out;
         for (const front::AutomatonInfo& a : c.module.automata)
-            if (a.loc.file == main_file) out += ir::print_automaton(a.automaton);
+            if (a.loc.file == main_file)
+                out += ir::print_automaton(a.automaton) + fmt::format("  contracts: {}\n", a.contraction);
         return out;
     }
     default: break;

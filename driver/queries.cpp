@@ -1,5 +1,7 @@
 #include "driver/queries.hpp"
 
+#include "runtime/automata/dimension.hpp"
+#include "runtime/automata/tabulate.hpp"
 #include "runtime/dimension.hpp"
 #include "runtime/rss.hpp"
 
@@ -7,6 +9,15 @@
 #include <stdexcept>
 
 namespace frac::driver {
+
+ir::Interval automaton_dimension(const front::AutomatonInfo& a) {
+    const rt::SimilarityDimension d = rt::similarity_dimension(a.automaton);
+    if (!d.defined)
+        throw RunError(fmt::format("dimension of '{}': {} (its similarity dimension needs similitudes; "
+                                   "frac dimension FILE {} counts boxes of its cover)",
+                                   a.name, d.reason, a.name));
+    return d.bracket;
+}
 
 std::vector<ir::Interval> answer_queries(const front::Module& m, const ir::Tape& tape,
                                          const EngineOptions& options, QueryAnswers& answers) {
@@ -16,6 +27,22 @@ std::vector<ir::Interval> answer_queries(const front::Module& m, const ir::Tape&
         if (tape.input_slots[k] == ir::no_slot) continue;
         if (!answers[k]) {
             const front::Query& q = m.queries[k];
+            if (q.kind == front::Query::Kind::automaton_dimension) {
+                answers[k] = automaton_dimension(m.automata.at(q.shape));
+                inputs[k] = *answers[k];
+                continue;
+            }
+            if (q.kind == front::Query::Kind::automaton_point) {
+                // A point value (the tabulated double, p compositions), not an enclosure.
+                const auto& a = m.automata.at(q.shape);
+                try {
+                    answers[k] = ir::Interval(rt::address_point(a.automaton, q.address).at(q.component));
+                } catch (const std::invalid_argument& e) {
+                    throw RunError(fmt::format("tabulate of '{}': {}", a.name, e.what()));
+                }
+                inputs[k] = *answers[k];
+                continue;
+            }
             const front::ShapeInfo& s = m.shapes[q.shape];
             auto eval = make_evaluator(m, s.root, s.dimension, options);
             if (q.kind == front::Query::Kind::enclose) {

@@ -19,6 +19,10 @@ using QueryAnswers = std::vector<std::optional<ir::Interval>>;
 std::vector<ir::Interval> answer_queries(const front::Module& m, const ir::Tape& tape,
                                          const EngineOptions& options, QueryAnswers& answers);
 
+// The similarity dimension of an automaton as a proven bracket (RunError when a map on a cycle is not a
+// similitude).
+ir::Interval automaton_dimension(const front::AutomatonInfo& a);
+
 // A closed expression (one that reads only query answers): its enclosure, and its point value when it
 // has one. An expression that reads an enclosure (enclose(s, B)) has none: the midpoint of the
 // enclosure would pose as one.

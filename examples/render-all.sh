@@ -36,6 +36,17 @@ render_as rough_terrain.frac terrain_profile 9 rough_terrain_profile
 "$frac" mesh "$here/rough_terrain.frac" terrain --depth 6 -o "$out/rough_terrain.stl"
 # The 3D-printable example: an exact, watertight STL of the sponge in its collar (every face on the lattice).
 "$frac" mesh "$here/menger_frame.frac" sponge_in_frame --depth 4 --split 3 -o "$out/menger_frame.stl"
+# Automata of the standard library (examples/automata.frac): evaluation trees and chaos games.
+automaton() { # name method depth-or-empty
+    "$frac" render "$here/automata.frac" "$1" --method "$2" --depth "${3:-8}" --size 512 -o "$out/automaton_$1.$4"
+}
+automaton sierpinski tree 7 png
+automaton koch_curve tree 6 svg
+automaton quadratic_bspline tree 6 svg
+automaton cubic_bspline tree 6 svg
+automaton barnsley_fern chaos "" png
+automaton fern_of_triangles chaos "" png
+automaton penrose chaos "" png
 echo
 echo "pictures (left: recursive subdivision process, right: cover) and meshes are in $out:"
 ls -1 "$out" | sed "s|^|  $out/|"

@@ -20,6 +20,7 @@ enum class BuiltinKind {
     transform, // translate, rotate, scale, shear: an affine map of R2 or R3 (constant arguments)
     controls,  // controls(P0, ..., Pn-1): the projection of bary(n) by control points
     primitive, // point, segment, polyline, polygon: what a state of an automaton draws
+    tabulate,  // tabulate(automaton, t): the point F(t) of its address map, t = i / N^p (tests, print)
 };
 
 struct Builtin {

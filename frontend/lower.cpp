@@ -6,6 +6,7 @@
 #include "frontend/orbit_escape.hpp"
 #include "frontend/series_bounds.hpp"
 #include "frontend/typecheck.hpp"
+#include "ir/automaton_check.hpp"
 #include "numeric/rational.hpp"
 
 #include <cmath>
@@ -80,12 +81,31 @@ public:
         : Inliner(limits.max_inline_depth), p_(p), typed_(typed), sm_(sm), limits_(limits), m_(m),
           g_(m.graph), d_(d) {}
 
-    void run() {
+    void declare() {
         for (const Item& it : p_.items) {
             if (it.kind == ItemKind::fn || it.kind == ItemKind::const_ || it.kind == ItemKind::shape ||
                 it.kind == ItemKind::automaton)
                 globals_[it.name] = &it;
         }
+    }
+
+    // The components of fn `map` (of one point) applied to the point (Var(0), ..., Var(d - 1)).
+    std::vector<NodeId> point_map(const Item& map, int dimension) {
+        Value p;
+        p.kind = ValueKind::point;
+        for (int k = 0; k < dimension; ++k) p.nodes.push_back(g_.var(k));
+        if (map.kind != ItemKind::fn || map.params.size() != 1)
+            fail(map.loc,
+                 fmt::format("'{}' is not a map of the plane: a map is a fn of one point", map.name));
+        const Value q = inline_body(map, {{map.params[0].name, p}}, map.loc, Context::shape);
+        if (q.kind != ValueKind::point || static_cast<int>(q.nodes.size()) != dimension)
+            fail(map.body->loc,
+                 fmt::format("the map '{}' must return a point of {} coordinates", map.name, dimension));
+        return q.nodes;
+    }
+
+    void run() {
+        declare();
         // Shapes first, in source order, so that tests can refer to any of them; then automata.
         for (const Item& it : p_.items)
             if (it.kind == ItemKind::shape && !typed_.failed.count(&it)) guarded([&] { shape_info(it); });
@@ -430,8 +450,45 @@ private:
             return linear_value(LinearValue::matrix(controls(points)));
         }
         case BuiltinKind::primitive: break; // only after `primitive` (automaton_info)
+        case BuiltinKind::tabulate: return tabulate(e);
         }
         throw InternalError("unknown builtin kind");
+    }
+
+    // tabulate(A, t): F(t) at t = i / N^p, N the arcs per state, read as p digits (seed 003, sec. 2).
+    Value tabulate(const Expr& e) {
+        const Value av = expr(*e.args[0].value);
+        const std::size_t index = automaton_index_.at(av.automaton);
+        const ir::Automaton& a = m_.automata[index].automaton;
+        const NodeId tn = scalar(expr(*e.args[1].value), e.args[1].loc);
+        const num::Rational* t = g_.exact_value(tn);
+        if (!t || t->sign() < 0 || *t >= num::Rational(1))
+            fail(e.args[1].loc, "'tabulate' needs an exact t with 0 <= t < 1, such as 3/8");
+        const std::size_t base = a.arcs_from(a.initial).size();
+        Query q;
+        q.loc = e.loc;
+        q.kind = Query::Kind::automaton_point;
+        q.shape = index;
+        num::Rational scaled = *t;
+        constexpr int max_digits = 60;
+        for (int p = 0; !scaled.is_integer(); ++p) {
+            if (p == max_digits || base < 2)
+                fail(e.args[1].loc,
+                     fmt::format("t = {} is not of the form i / {}^p (p <= {}): '{}' has {} maps per state",
+                                 t->to_string(), base, max_digits, av.automaton->name, base));
+            scaled *= num::Rational(static_cast<long>(base));
+            const num::Rational digit(mpq_class(scaled.numerator() / scaled.denominator()));
+            q.address.push_back(static_cast<std::size_t>(digit.to_double()));
+            scaled -= digit;
+        }
+        Value r;
+        r.kind = ValueKind::point;
+        for (int k = 0; k < a.output_dimension(); ++k) {
+            q.component = k;
+            m_.queries.push_back(q);
+            r.nodes.push_back(g_.var(static_cast<int>(m_.queries.size() - 1)));
+        }
+        return r;
     }
 
     // ---- operators and automata ----
@@ -522,6 +579,28 @@ private:
         return p;
     }
 
+    // The checks that need the operators' values (ir/automaton_check.hpp): barycentric columns summing
+    // to 1, probabilities, dead ends, unreachable states (a warning), and a proof of contraction.
+    void check(AutomatonInfo& info) {
+        ir::ContractivityResult proof;
+        bool failed = false;
+        for (const ir::AutomatonProblem& p : ir::check_automaton(info.automaton, {}, &proof)) {
+            const Location loc = p.arc     ? info.arc_locs.at(*p.arc)
+                                 : p.state ? info.state_locs.at(*p.state)
+                                           : info.loc;
+            if (p.severity == ir::AutomatonProblem::Severity::warning) {
+                d_.warning(loc, p.message);
+                continue;
+            }
+            d_.error(loc, p.kind == ir::AutomatonProblem::Kind::contractivity
+                              ? fmt::format("'{}': {}", info.name, p.message)
+                              : p.message);
+            failed = true;
+        }
+        if (failed) throw AlreadyReported{};
+        info.contraction = proof.message;
+    }
+
     void automaton_info(const Item& it) {
         const AutomatonDecl& decl = *it.automaton;
         AutomatonInfo info;
@@ -559,6 +638,7 @@ private:
         }
         a.initial = decl.initial.empty() ? 0 : index(decl.initial);
         if (decl.projection) a.projection = closed(*decl.projection, Context::constant).linear->in(0);
+        check(info);
         m_.automata.push_back(std::move(info));
         automaton_index_[&it] = m_.automata.size() - 1;
     }
@@ -828,6 +908,15 @@ private:
 void lower(const Program& program, const TypedProgram& typed, const SourceManager& sources,
            const Limits& limits, Module& out, Diagnostics& diags) {
     Lowering(program, typed, sources, limits, out, diags).run();
+}
+
+std::vector<NodeId> lower_point_map(const Program& program, const TypedProgram& typed,
+                                    const SourceManager& sources, const Limits& limits, Module& out,
+                                    const Item& map, int dimension) {
+    Diagnostics unused; // errors are thrown as CompileError
+    Lowering lowering(program, typed, sources, limits, out, unused);
+    lowering.declare();
+    return lowering.point_map(map, dimension);
 }
 
 } // namespace frac::front

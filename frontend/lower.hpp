@@ -20,4 +20,11 @@ struct TypedProgram;
 void lower(const Program& program, const TypedProgram& typed, const SourceManager& sources,
            const Limits& limits, Module& out, Diagnostics& diags);
 
+// A map of the plane or space for dynamical systems (fn henon(p) = (...)): the graph nodes of its
+// components applied to the point (Var(0), ..., Var(dimension - 1)), added to out.graph. Throws
+// CompileError when `map` is no fn of one point returning a point of `dimension` coordinates.
+std::vector<NodeId> lower_point_map(const Program& program, const TypedProgram& typed,
+                                    const SourceManager& sources, const Limits& limits, Module& out,
+                                    const Item& map, int dimension);
+
 } // namespace frac::front

@@ -28,16 +28,19 @@ struct AutomatonInfo {
     Location loc;
     ir::Automaton automaton;
     std::vector<Location> state_locs, arc_locs; // by state and arc index
+    std::string contraction;                    // how the compiler proved that the system contracts
 };
 
 // A run-time question a test asks of a shape or an automaton; its answer is the input Var(index) of
 // test graphs.
 struct Query {
-    enum class Kind { enclose, dimension, automaton_dimension } kind = Kind::enclose;
+    enum class Kind { enclose, dimension, automaton_dimension, automaton_point } kind = Kind::enclose;
     Location loc;
-    std::size_t shape = 0;           // index into Module::shapes (Module::automata for automaton_dimension)
-    std::vector<Interval> box;       // enclose: the box; dimension: the root box
-    int from = 0, to = 0, split = 2; // dimension: levels used for box counting
+    std::size_t shape = 0;            // index into Module::shapes (Module::automata for automaton_dimension)
+    std::vector<Interval> box;        // enclose: the box; dimension: the root box
+    int from = 0, to = 0, split = 2;  // dimension: levels used for box counting
+    std::vector<std::size_t> address; // automaton_point: the arcs taken (base-N digits of t = i / N^p)
+    int component = 0;                // automaton_point: the coordinate of F(t) asked for
 };
 
 enum class ValueKind { scalar, boolean, point, interval, box };

@@ -333,6 +333,17 @@ private:
 
     TValue call_builtin(const Builtin& b, const Expr& e) {
         if (b.kind == BuiltinKind::enclose || b.kind == BuiltinKind::dimension) return query(e, b);
+        if (b.kind == BuiltinKind::tabulate) {
+            if (frames_.back().ctx != Context::test)
+                fail(
+                    e.loc,
+                    "'tabulate' runs a computation on an automaton; it is available in tests and print only");
+            const Type a = expr(*e.args[0].value).type;
+            if (a.kind != Type::Kind::automaton)
+                fail(e.args[0].loc, fmt::format("'tabulate' needs an ifs or cifs, found {}", type_name(a)));
+            require_number(expr(*e.args[1].value).type, e.args[1].loc);
+            return TValue::of(Type::point(a.size));
+        }
         if (b.kind == BuiltinKind::controls) return TValue::of(controls_type(e));
         if (b.kind == BuiltinKind::primitive)
             fail(e.loc,
@@ -388,7 +399,14 @@ private:
             failed_.insert(&it);
             throw;
         }
-        return out_.items[&it] = Type{Type::Kind::automaton};
+        // Its size: the dimension of the space its attractor is drawn in.
+        const AutomatonDecl& a = *it.automaton;
+        const StateDecl* initial = &a.states.front();
+        for (const StateDecl& s : a.states)
+            if (s.name == a.initial) initial = &s;
+        const int drawn = initial->space.barycentric ? closed(*a.projection, Context::constant).type.rows - 1
+                                                     : initial->space.n;
+        return out_.items[&it] = Type{Type::Kind::automaton, drawn};
     }
 
     void check_automaton(const Item& it) {

@@ -171,7 +171,8 @@ NodeId Graph::var(int index) {
 }
 
 NodeId Graph::index(int level) {
-    if (level < 1 || level > 63) throw std::invalid_argument("series nesting level out of range");
+    if (level < 1 || level > max_series_level)
+        throw std::invalid_argument("series nesting level out of range");
     Node n;
     n.op = Op::Index;
     n.imm = level;
@@ -179,7 +180,7 @@ NodeId Graph::index(int level) {
 }
 
 NodeId Graph::state(int level, int component) {
-    if (level < 1 || level > 63 || component < 0 || component > 7)
+    if (level < 1 || level > max_series_level || component < 0 || component >= max_state_components)
         throw std::invalid_argument("orbit state out of range");
     Node n;
     n.op = Op::State;

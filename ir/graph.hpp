@@ -37,15 +37,18 @@ inline bool is_series(Op op) {
 
 using NodeId = std::uint32_t;
 
-// A State leaf's imm names the series level (1..63) and the component (0..7) of its orbit point.
+// A State leaf's imm names the series level (1..max_series_level) and the component
+// (0..max_state_components - 1) of its orbit point.
+inline constexpr int max_series_level = 63;
+inline constexpr int max_state_components = 8;
 inline constexpr std::int64_t state_imm(int level, int component) {
-    return std::int64_t{level} * 8 + component;
+    return std::int64_t{level} * max_state_components + component;
 }
 inline constexpr int state_level(std::int64_t imm) {
-    return static_cast<int>(imm / 8);
+    return static_cast<int>(imm / max_state_components);
 }
 inline constexpr int state_component(std::int64_t imm) {
-    return static_cast<int>(imm % 8);
+    return static_cast<int>(imm % max_state_components);
 }
 inline constexpr NodeId no_node = std::numeric_limits<NodeId>::max();
 inline constexpr std::int64_t infinite_end = std::numeric_limits<std::int64_t>::max();

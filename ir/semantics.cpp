@@ -73,13 +73,8 @@ Interval apply_interval(Op op, const Interval* a, std::int64_t imm) {
         if (a[0] == tv_true) return a[1];
         if (a[0] == tv_false) return a[2];
         return hull(a[1], a[2]);
-    case Op::Const:
-    case Op::Var:
-    case Op::Index:
-    case Op::State:
-    case Op::SeriesSum:
-    case Op::SeriesMin:
-    case Op::SeriesMax: break;
+#include "ir/non_operation_cases.def"
+        break;
     }
     throw std::logic_error(std::string("apply_interval: not an operation: ") + op_name(op));
 }
@@ -118,13 +113,8 @@ double apply_point(Op op, const double* a, std::int64_t imm) {
     case Op::Or: return a[0] > 0.5 || a[1] > 0.5;
     case Op::Not: return !(a[0] > 0.5);
     case Op::Select: return a[0] > 0.5 ? a[1] : a[2];
-    case Op::Const:
-    case Op::Var:
-    case Op::Index:
-    case Op::State:
-    case Op::SeriesSum:
-    case Op::SeriesMin:
-    case Op::SeriesMax: break;
+#include "ir/non_operation_cases.def"
+        break;
     }
     throw std::logic_error(std::string("apply_point: not an operation: ") + op_name(op));
 }

@@ -17,8 +17,9 @@ std::string verify_graph(const Graph& g) {
                 return fmt::format("%{}: {} has too many arguments", id, op_name(n.op));
             if (a != no_node && a >= id) return fmt::format("%{}: argument %{} is not earlier", id, a);
         }
-        if (n.op == Op::Index && (n.imm < 1 || n.imm > 63)) return fmt::format("%{}: bad index level", id);
-        if (n.op == Op::State && (state_level(n.imm) < 1 || state_level(n.imm) > 63))
+        if (n.op == Op::Index && (n.imm < 1 || n.imm > max_series_level))
+            return fmt::format("%{}: bad index level", id);
+        if (n.op == Op::State && (state_level(n.imm) < 1 || state_level(n.imm) > max_series_level))
             return fmt::format("%{}: bad orbit state", id);
         if (n.orbit.size() != 2 * static_cast<std::size_t>(n.series.state_count))
             return fmt::format("%{}: orbit of the wrong size", id);

@@ -2,7 +2,7 @@
 // (inside cells, or inside plus boundary cells), as a closed, consistently oriented, 2-manifold
 // triangle mesh, for 3D printing (binary STL, OBJ, PLY).
 //
-// Construction (see mesh.cpp for the details and the correctness argument):
+// Construction (see mesh_build.cpp for the details and the correctness argument):
 //  - Everything happens on the finest lattice (split^depth cells per axis), without a dense 3D grid:
 //    for each axis and each lattice plane, the faces between selected and unselected cells are
 //    computed from the leaves that touch the plane (a sweep over the plane's squares) and merged

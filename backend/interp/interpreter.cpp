@@ -125,7 +125,7 @@ private:
     // p <- M(p) for all components at once: a map's component may be another state slot (a swap).
     template <class V>
     static void advance_orbit(std::vector<V>& regs, const TapeSeries& s) {
-        V next[8];
+        V next[ir::max_state_components];
         for (std::size_t c = 0; c < s.state_slots.size(); ++c) next[c] = regs[s.update_slots[c]];
         for (std::size_t c = 0; c < s.state_slots.size(); ++c) regs[s.state_slots[c]] = next[c];
     }
@@ -179,7 +179,7 @@ private:
                 Interval tail = ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i);
                 double escape_now = 0.0;
                 if (escape) {
-                    Interval state[8];
+                    Interval state[ir::max_state_components];
                     const int dims = load_state(s, state);
                     escape_now = ir::escape_bound(s.kind, s.data.escape, state, dims, i + 1);
                     tail = ir::escape_tighten(s.kind, tail, escape_now);
@@ -206,7 +206,7 @@ private:
         if (!resolved) ++stats.series_capped;
         const Interval tail = ir::series_tail(s.kind, a, b, has_b, s.data.gamma, i);
         if (!s.data.escape.present) return ir::series_combine(s.kind, acc, tail);
-        Interval state[8];
+        Interval state[ir::max_state_components];
         const int dims = load_state(s, state);
         return ir::lipschitz_finish(s.kind, s.data.escape, acc, tail,
                                     ir::escape_bound_around(s.kind, s.data.escape, state, dims, i + 1, h), i,
@@ -218,7 +218,7 @@ private:
         return static_cast<int>(s.state_slots.size());
     }
     double centre_orbit(const TapeSeries& s) {
-        Interval state[8];
+        Interval state[ir::max_state_components];
         const int dims = load_state(s, state);
         const double h = ir::lipschitz_centre(state, dims);
         for (int c = 0; c < dims; ++c) boxes_[s.state_slots[static_cast<std::size_t>(c)]] = state[c];
@@ -258,7 +258,7 @@ private:
             if (i == last) break;
             if (infinite && s.data.escape.present) {
                 // The escape certificate bounds every later term from the orbit point q_{i+1}.
-                double state[8];
+                double state[ir::max_state_components];
                 for (std::size_t c = 0; c < s.state_slots.size(); ++c) state[c] = points_[s.state_slots[c]];
                 if (ir::escape_point_done(s.kind, s.data.escape, acc, state,
                                           static_cast<int>(s.state_slots.size()), i + 1)) {

@@ -100,7 +100,7 @@ void frac_jit_vescape(int kind, const double* in, const std::int64_t* n, double*
     const auto o = static_cast<frac::ir::Op>(kind);
     const frac::ir::OrbitEscape e = escape_of(radius, slope, offset, scale0_lo, scale0_hi, growth_lo,
                                               growth_hi, lipschitz, map_lipschitz);
-    num::Interval state[8];
+    num::Interval state[frac::ir::max_state_components];
     for (int l = 0; l < lanes; ++l) {
         if (!(mask >> l & 1)) {
             out[l] = out[lanes + l] = o == frac::ir::Op::SeriesMax ? num::inf : -num::inf;
@@ -113,7 +113,7 @@ void frac_jit_vescape(int kind, const double* in, const std::int64_t* n, double*
 }
 
 void frac_jit_vcentre(double* in, int dims, double* h, std::uint32_t mask, int lanes) noexcept {
-    num::Interval state[8];
+    num::Interval state[frac::ir::max_state_components];
     for (int l = 0; l < lanes; ++l) {
         h[l] = 0.0;
         if (!(mask >> l & 1)) continue;

@@ -168,13 +168,8 @@ bool may_be_empty(Op op, const bool* in, std::int64_t imm, const Facts& divisor)
     case Op::Pow:
     case Op::Sqrt:
     case Op::Log: return true;
-    case Op::Const:
-    case Op::Var:
-    case Op::Index:
-    case Op::State:
-    case Op::SeriesSum:
-    case Op::SeriesMin:
-    case Op::SeriesMax: break;
+#include "ir/non_operation_cases.def"
+        break;
     }
     return true;
 }

@@ -1,0 +1,287 @@
+// The interval operations of box code: numeric/interval.cpp step by step (see box_gen.hpp).
+#include "backend/llvm/box_gen.hpp"
+
+#include <map>
+#include <stdexcept>
+
+namespace frac::jit::box {
+
+// ---- interval operations: numeric/interval.cpp, step by step ----
+SlotState BoxGen::op_add(const SlotState& a, const SlotState& b) {
+    Value* e = lor(empty_of(a), empty_of(b));
+    return result(guard(e, widen_nan(add_down(a.v.lo, b.v.lo), add(a.v.hi, b.v.hi)), empty()),
+                  a.f.maybe_empty || b.f.maybe_empty);
+}
+
+SlotState BoxGen::op_sub(const SlotState& a, const SlotState& b) {
+    Value* e = lor(empty_of(a), empty_of(b));
+    return result(guard(e, widen_nan(sub_down(a.v.lo, b.v.hi), sub(a.v.hi, b.v.lo)), empty()),
+                  a.f.maybe_empty || b.f.maybe_empty);
+}
+
+SlotState BoxGen::op_mul(const SlotState& a, const SlotState& b) {
+    Value* e = lor(empty_of(a), empty_of(b));
+    Value* za[2] = {is_zero(a, false), is_zero(a, true)};
+    Value* zb[2] = {is_zero(b, false), is_zero(b, true)};
+    Value* xa[2] = {a.v.lo, a.v.hi};
+    Value* xb[2] = {b.v.lo, b.v.hi};
+    Value* lo = nullptr;
+    Value* hi = nullptr;
+    // Corners in the order of interval.cpp: (lo,lo), (lo,hi), (hi,lo), (hi,hi); min/max_element
+    // keep the first of equal values. 0 * anything is 0.
+    std::map<std::pair<Value*, Value*>, std::pair<Value*, Value*>> memo;
+    for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j) {
+            auto key = std::make_pair(xa[i], xb[j]);
+            auto it = memo.find(key);
+            if (it == memo.end()) {
+                Value* z = b_.CreateOr(za[i], zb[j]);
+                Value* dn = sel(z, cst(0.0), mul_down(xa[i], xb[j]));
+                Value* up = sel(z, cst(0.0), mul(xa[i], xb[j]));
+                it = memo.emplace(key, std::make_pair(dn, up)).first;
+            }
+            Value* dn = it->second.first;
+            Value* up = it->second.second;
+            lo = lo ? (dn == lo ? lo : sel(lt(dn, lo), dn, lo)) : dn;
+            hi = hi ? (up == hi ? hi : sel(lt(hi, up), up, hi)) : up;
+        }
+    return result(guard(e, {lo, hi}, empty()), a.f.maybe_empty || b.f.maybe_empty);
+}
+
+// a / b for b not containing 0 and nothing empty; `pos`: b.lo > 0 (else b.hi < 0).
+IV BoxGen::div_nonzero(const SlotState& a, const SlotState& b, Value* pos) {
+    Value* alo_nonneg = ge(a.v.lo, cst(0.0));
+    Value* ahi_nonpos = le(a.v.hi, cst(0.0));
+    Value* lo_num = sel(pos, a.v.lo, a.v.hi);
+    Value* lo_den =
+        sel(pos, sel(alo_nonneg, b.v.hi, b.v.lo), sel(land(lnot(alo_nonneg), ahi_nonpos), b.v.lo, b.v.hi));
+    Value* hi_num = sel(pos, a.v.hi, a.v.lo);
+    Value* hi_den =
+        sel(pos, sel(alo_nonneg, b.v.lo, sel(ahi_nonpos, b.v.hi, b.v.lo)), sel(alo_nonneg, b.v.lo, b.v.hi));
+    return widen_nan(div_down(lo_num, lo_den), div(hi_num, hi_den));
+}
+
+SlotState BoxGen::op_div(const SlotState& a, const SlotState& b) {
+    // A divisor of statically known sign: the branch the interpreter takes.
+    if (b.f.lo_positive || b.f.hi_negative)
+        return result(guard(empty_of(a), div_nonzero(a, b, i1(b.f.lo_positive)), empty()), a.f.maybe_empty);
+    Value* pos = gt(b.v.lo, cst(0.0));
+    Value* fast = b_.CreateOr(pos, lt(b.v.hi, cst(0.0)));
+    if (Value* e = lor(empty_of(a), empty_of(b))) fast = land(fast, lnot(e));
+    const IV rf = div_nonzero(a, b, pos); // garbage in the other lanes, replaced below
+    Value* slow = land(ctx_mask_, lnot(fast));
+    BasicBlock* pre = b_.GetInsertBlock();
+    BasicBlock* slow_bb = BasicBlock::Create(ctx_, "div.slow", fn_);
+    BasicBlock* join = BasicBlock::Create(ctx_, "div.join", fn_);
+    b_.CreateCondBr(any(slow), slow_bb, join);
+    b_.SetInsertPoint(slow_bb);
+    IV rs;
+    if (w_ == 1) {
+        rs = call_scalar("frac_jit_div", {a.v.lo, a.v.hi, b.v.lo, b.v.hi});
+    } else {
+        const IV core = call_vector(Op::Div, 0, {a.v, b.v}, slow);
+        rs = {sel(slow, core.lo, rf.lo), sel(slow, core.hi, rf.hi)};
+    }
+    BasicBlock* slow_end = b_.GetInsertBlock();
+    b_.CreateBr(join);
+    b_.SetInsertPoint(join);
+    llvm::PHINode* lo = b_.CreatePHI(vt_, 2);
+    llvm::PHINode* hi = b_.CreatePHI(vt_, 2);
+    lo->addIncoming(rf.lo, pre);
+    lo->addIncoming(rs.lo, slow_end);
+    hi->addIncoming(rf.hi, pre);
+    hi->addIncoming(rs.hi, slow_end);
+    return result({lo, hi}, true);
+}
+
+SlotState BoxGen::op_neg(const SlotState& a) {
+    return result({neg(a.v.hi), neg(a.v.lo)}, a.f.maybe_empty);
+}
+
+IV BoxGen::abs_nonempty(IV a) {
+    Value* lo_nonneg = ge(a.lo, cst(0.0));
+    Value* hi_nonpos = le(a.hi, cst(0.0));
+    Value* nlo = neg(a.lo);
+    Value* lo = sel(lo_nonneg, a.lo, sel(hi_nonpos, neg(a.hi), cst(0.0)));
+    Value* hi = sel(lo_nonneg, a.hi, sel(hi_nonpos, nlo, std_max(nlo, a.hi)));
+    return {lo, hi};
+}
+
+SlotState BoxGen::op_abs(const SlotState& a) {
+    return result(guard(empty_of(a), abs_nonempty(a.v), a.v), a.f.maybe_empty);
+}
+
+Value* BoxGen::pow_up(Value* x, std::uint64_t n) {
+    Value* r = cst(1.0);
+    for (Value* p = x;; p = mul(p, p)) {
+        if (n & 1) r = mul(r, p);
+        if ((n >>= 1) == 0) return r;
+    }
+}
+
+Value* BoxGen::pow_down(Value* x, std::uint64_t n) {
+    Value* r = cst(1.0);
+    for (Value* p = x;; p = mul_down(p, p)) {
+        if (n & 1) r = mul_down(r, p);
+        if ((n >>= 1) == 0) return r;
+    }
+}
+
+IV BoxGen::pow_positive(IV a, std::uint64_t n) {
+    if (n % 2 == 0) {
+        const IV m = abs_nonempty(a);
+        return {pow_down(m.lo, n), pow_up(m.hi, n)};
+    }
+    Value* lo = sel(ge(a.lo, cst(0.0)), pow_down(a.lo, n), neg(pow_up(neg(a.lo), n)));
+    Value* hi = sel(ge(a.hi, cst(0.0)), pow_up(a.hi, n), neg(pow_down(neg(a.hi), n)));
+    return {lo, hi};
+}
+
+SlotState BoxGen::op_sqr(const SlotState& a) {
+    return result(guard(empty_of(a), pow_positive(a.v, 2), a.v), a.f.maybe_empty);
+}
+
+SlotState BoxGen::op_powi(const SlotState& a, std::int64_t n) {
+    if (n == 0) return result(guard(empty_of(a), {cst(1.0), cst(1.0)}, a.v), a.f.maybe_empty);
+    // Negative powers divide; huge ones would unroll for nothing: the core does both.
+    if (n < 0 || n > 1024) return call_core(Op::PowI, n, {&a}, true);
+    return result(guard(empty_of(a), pow_positive(a.v, static_cast<std::uint64_t>(n)), a.v), a.f.maybe_empty);
+}
+
+SlotState BoxGen::op_minmax(const SlotState& a, const SlotState& b, bool is_min) {
+    Value* e = lor(empty_of(a), empty_of(b));
+    const IV r = is_min ? IV{std_min(a.v.lo, b.v.lo), std_min(a.v.hi, b.v.hi)}
+                        : IV{std_max(a.v.lo, b.v.lo), std_max(a.v.hi, b.v.hi)};
+    return result(guard(e, r, empty()), a.f.maybe_empty || b.f.maybe_empty);
+}
+
+SlotState BoxGen::op_round(const SlotState& a, bool up) {
+    const IV r = up ? IV{ceil(a.v.lo), ceil(a.v.hi)} : IV{floor(a.v.lo), floor(a.v.hi)};
+    return result(guard(empty_of(a), r, a.v), a.f.maybe_empty);
+}
+
+Value* BoxGen::is_finite(Value* x) {
+    return lt(fabs(x), cst(inf));
+}
+
+SlotState BoxGen::op_mod1(const SlotState& a) {
+    Value* f = floor(a.v.lo);
+    Value* whole = b_.CreateOr(lnot(land(is_finite(a.v.lo), is_finite(a.v.hi))),
+                               cmp(llvm::CmpInst::FCMP_UNE, floor(a.v.hi), f));
+    const IV r{sel(whole, cst(0.0), sub_down(a.v.lo, f)), sel(whole, cst(1.0), sub(a.v.hi, f))};
+    return result(guard(empty_of(a), r, a.v), a.f.maybe_empty);
+}
+
+SlotState BoxGen::op_dz(const SlotState& a) {
+    Value* lo = a.v.lo;
+    Value* hi = a.v.hi;
+    Value* whole = lnot(lt(sub(hi, lo), cst(1.0))); // !(hi - lo < 1): a whole period
+    Value* fl = floor(lo);
+    Value* cl = ceil(lo);
+    Value* fh = floor(hi);
+    Value* ch = ceil(hi);
+    // dz_down(x) = min(sub_down(x, floor x), sub_down(ceil x, x)); dz_up(x) = min(x - floor x, ceil x -
+    // x)
+    Value* rlo =
+        std_min(std_min(sub_down(lo, fl), sub_down(cl, lo)), std_min(sub_down(hi, fh), sub_down(ch, hi)));
+    Value* rhi = std_max(std_min(sub(lo, fl), sub(cl, lo)), std_min(sub(hi, fh), sub(ch, hi)));
+    rlo = sel(le(cl, hi), cst(0.0), rlo);
+    Value* half = add(fl, cst(0.5));
+    half = sel(lt(half, lo), add(half, cst(1.0)), half);
+    rhi = sel(le(half, hi), cst(0.5), rhi);
+    const IV r{sel(whole, cst(0.0), rlo), sel(whole, cst(0.5), rhi)};
+    return result(guard(empty_of(a), r, a.v), a.f.maybe_empty);
+}
+
+SlotState BoxGen::op_not(const SlotState& a) {
+    const IV r{sub(cst(1.0), a.v.hi), sub(cst(1.0), a.v.lo)};
+    return result(guard(empty_of(a), r, empty()), a.f.maybe_empty);
+}
+
+SlotState BoxGen::op_andor(const SlotState& a, const SlotState& b, bool is_and) {
+    Value* e = lor(empty_of(a), empty_of(b));
+    const IV r = is_and ? IV{c_fmin(a.v.lo, b.v.lo), c_fmin(a.v.hi, b.v.hi)}
+                        : IV{c_fmax(a.v.lo, b.v.lo), c_fmax(a.v.hi, b.v.hi)};
+    return result(guard(e, r, empty()), a.f.maybe_empty || b.f.maybe_empty);
+}
+
+IV BoxGen::truth(Value* t, Value* f) {
+    return {sel(t, cst(1.0), cst(0.0)), sel(b_.CreateOr(t, lnot(f)), cst(1.0), cst(0.0))};
+}
+
+SlotState BoxGen::op_compare(Op op, const SlotState& a, const SlotState& b) {
+    Value* e = lor(empty_of(a), empty_of(b));
+    const IV& x = a.v;
+    const IV& y = b.v;
+    IV r;
+    switch (op) {
+    case Op::Lt: r = truth(lt(x.hi, y.lo), ge(x.lo, y.hi)); break;
+    case Op::Le: r = truth(le(x.hi, y.lo), gt(x.lo, y.hi)); break;
+    case Op::Gt: r = truth(gt(x.lo, y.hi), le(x.hi, y.lo)); break;
+    case Op::Ge: r = truth(ge(x.lo, y.hi), lt(x.hi, y.lo)); break;
+    case Op::Eq:
+    case Op::Ne: {
+        Value* same = land(eq(x.lo, x.hi), land(eq(x.lo, y.lo), eq(x.hi, y.hi)));
+        Value* apart = b_.CreateOr(lt(x.hi, y.lo), lt(y.hi, x.lo));
+        r = op == Op::Eq ? truth(same, apart) : truth(apart, same);
+        break;
+    }
+    default: throw std::logic_error("jit: op_compare");
+    }
+    return result(guard(e, r, empty()), a.f.maybe_empty || b.f.maybe_empty);
+}
+
+SlotState BoxGen::op_select(const SlotState& c, const SlotState& x, const SlotState& y) {
+    IV h{std_min(x.v.lo, y.v.lo), std_max(x.v.hi, y.v.hi)}; // hull: an empty side gives the other
+    if (Value* ey = empty_of(y)) h = guard(ey, h, x.v);
+    if (Value* ex = empty_of(x)) h = guard(ex, h, y.v);
+    Value* is_true = land(eq(c.v.lo, cst(1.0)), eq(c.v.hi, cst(1.0)));
+    Value* is_false = land(eq(c.v.lo, cst(0.0)), eq(c.v.hi, cst(0.0)));
+    IV r = guard(is_false, h, y.v);
+    r = guard(is_true, r, x.v);
+    r = guard(empty_of(c), r, empty());
+    return result(r, c.f.maybe_empty || x.f.maybe_empty || y.f.maybe_empty);
+}
+
+SlotState BoxGen::emit_op(const Instr& ins) {
+    auto in = [&](int k) -> const SlotState& { return vals_[ins.in[static_cast<std::size_t>(k)]]; };
+    switch (ins.op) {
+    case Op::Add: return op_add(in(0), in(1));
+    case Op::Sub: return op_sub(in(0), in(1));
+    case Op::Mul: return op_mul(in(0), in(1));
+    case Op::Div: return op_div(in(0), in(1));
+    case Op::Neg: return op_neg(in(0));
+    case Op::Sqr: return op_sqr(in(0));
+    case Op::PowI: return op_powi(in(0), ins.imm);
+    case Op::Abs: return op_abs(in(0));
+    case Op::Min: return op_minmax(in(0), in(1), true);
+    case Op::Max: return op_minmax(in(0), in(1), false);
+    case Op::Floor: return op_round(in(0), false);
+    case Op::Ceil: return op_round(in(0), true);
+    case Op::Mod1: return op_mod1(in(0));
+    case Op::Dz: return op_dz(in(0));
+    case Op::Pow:
+    case Op::Sqrt:
+    case Op::Log: return call_core(ins.op, 0, {&in(0), &in(ir::arity(ins.op) > 1 ? 1 : 0)}, true);
+    case Op::Sin:
+    case Op::Cos:
+    case Op::Tan:
+    case Op::Exp: return call_core(ins.op, 0, {&in(0)}, in(0).f.maybe_empty);
+    case Op::Atan2: return call_core(ins.op, 0, {&in(0), &in(1)}, in(0).f.maybe_empty || in(1).f.maybe_empty);
+    case Op::Lt:
+    case Op::Le:
+    case Op::Gt:
+    case Op::Ge:
+    case Op::Eq:
+    case Op::Ne: return op_compare(ins.op, in(0), in(1));
+    case Op::And: return op_andor(in(0), in(1), true);
+    case Op::Or: return op_andor(in(0), in(1), false);
+    case Op::Not: return op_not(in(0));
+    case Op::Select: return op_select(in(0), in(1), in(2));
+#include "ir/non_operation_cases.def"
+        break;
+    }
+    throw std::logic_error(std::string("jit: not an operation: ") + ir::op_name(ins.op));
+}
+
+} // namespace frac::jit::box

@@ -1,0 +1,201 @@
+// frac tree, frac chaos, and render / dimension of automata (ifs, cifs).
+#include "cli/commands.hpp"
+
+#include "driver/queries.hpp"
+#include "frontend/lower.hpp"
+#include "runtime/automata/attractor_cover.hpp"
+#include "runtime/automata/chaos.hpp"
+#include "runtime/automata/dimension.hpp"
+#include "runtime/automata/tree.hpp"
+#include "runtime/dimension.hpp"
+#include "runtime/legend.hpp"
+#include "runtime/picture.hpp"
+
+#include <fmt/format.h>
+#include <iostream>
+#include <stdexcept>
+
+namespace frac::cli {
+
+namespace {
+
+// Runs a runtime job, turning its refusals (std::invalid_argument) into run-time errors.
+template <class F>
+auto runtime_job(F&& job) {
+    try {
+        return job();
+    } catch (const std::invalid_argument& e) {
+        throw RunError(e.what());
+    }
+}
+
+void check_picture_output(const std::string& path, bool svg_allowed) {
+    if (path.empty()) throw UsageError("give the picture file: -o FILE.png");
+    if (!ends_with(path, ".png") && !(svg_allowed && ends_with(path, ".svg")))
+        throw UsageError(fmt::format("cannot tell the picture format of '{}': use .png{}", path,
+                                     svg_allowed ? " or .svg" : ""));
+    check_output_writable(path);
+}
+
+// The primitives of the evaluation tree's leaves, one colour per state (.svg: curves as polylines).
+void draw_tree(const ir::Automaton& a, int depth, const std::string& output, int size) {
+    runtime_job([&] {
+        if (ends_with(output, ".svg"))
+            rt::write_tree_svg(a, depth, output);
+        else
+            rt::write_tree_png(a, depth, output, size);
+        return 0;
+    });
+    std::cout << fmt::format("wrote {} (evaluation tree of {} to depth {})\n", output, a.name, depth);
+}
+
+// The cover's picture, and how each graph of the refinement went.
+void write_cover(const rt::AttractorCoverResult& cover, const RenderOptions& o, const std::string& name) {
+    const rt::PictureKind kind = o.kind == "process" ? rt::PictureKind::process
+                                 : o.kind == "cover" ? rt::PictureKind::cover
+                                                     : rt::PictureKind::both;
+    if (ends_with(o.output, ".png"))
+        rt::write_png(rt::with_legend(rt::render(cover, kind, o.size), kind), o.output);
+    else
+        rt::write_svg(cover, o.output, kind);
+    for (const rt::CoverStep& s : cover.steps)
+        std::cout << fmt::format("level {:2}: {} cells, {} arcs, {} kept, area {:.6g}\n", s.level, s.cells,
+                                 s.arcs, s.kept, s.area);
+    std::cout << fmt::format("wrote {} (cell-graph cover of {})\n", o.output, name);
+}
+
+} // namespace
+
+const front::AutomatonInfo& find_automaton(const front::Compilation& c, const std::string& name) {
+    if (const front::AutomatonInfo* a = c.module.find_automaton(name)) return *a;
+    std::vector<std::string> known;
+    for (const auto& a : c.module.automata) known.push_back(a.name);
+    no_such_name("ifs or cifs", name, known, "automata");
+}
+
+int run_tree(const std::string& file, const TreeOptions& o) {
+    if (o.depth < 0 || o.depth > 24) throw UsageError("--depth must be between 0 and 24");
+    if (!o.output.empty()) check_picture_output(o.output, true);
+    auto c = compile_or_report(file);
+    if (!c) return front::exit_compile_error;
+    const ir::Automaton& a = find_automaton(*c, o.name).automaton;
+    if (o.output.empty()) { // the text dump (--emit=tree): each node's state and composite operator
+        runtime_job([&] {
+            rt::write_tree_text(a, o.depth, std::cout, o.matrices);
+            return 0;
+        });
+        return 0;
+    }
+    draw_tree(a, o.depth, o.output, o.size);
+    return 0;
+}
+
+int run_chaos(const std::string& file, const ChaosCommandOptions& o) {
+    check_picture_output(o.output, false);
+    if (o.points < 1 || o.points > 4'000'000'000ULL) throw UsageError("-n must be between 1 and 4e9 points");
+    if (o.size < 16 || o.size > 8192) throw UsageError("--size must be between 16 and 8192 pixels");
+    auto c = compile_or_report(file);
+    if (!c) return front::exit_compile_error;
+    const ir::Automaton& a = find_automaton(*c, o.name).automaton;
+    rt::ChaosOptions co;
+    co.points = o.points;
+    co.seed = o.seed;
+    co.threads = o.threads;
+    co.width = o.size;
+    const rt::Density d = runtime_job([&] { return rt::chaos_game(a, co); });
+    rt::write_density_png(d, o.output);
+    std::cout << fmt::format("wrote {} ({} points of {}, seed {}, over [{}, {}] × [{}, {}])\n", o.output,
+                             d.recorded, a.name, o.seed, d.x0, d.x1, d.y0, d.y1);
+    return 0;
+}
+
+int render_automaton(const front::AutomatonInfo& info, const RenderOptions& o) {
+    const ir::Automaton& a = info.automaton;
+    if (o.output.empty())
+        throw UsageError("render of an automaton needs -o FILE.png (or .svg for --method tree)");
+    std::string method = o.method;
+    if (method.empty()) {
+        method = "chaos";
+        for (const ir::State& s : a.states)
+            if (s.primitive.kind != ir::Primitive::Kind::none) method = "tree";
+    }
+    if (method == "chaos" && ends_with(o.output, ".svg"))
+        throw UsageError("--method chaos draws a .png; .svg is for --method tree or cover");
+    if (method == "tree") {
+        if (o.depth > 24) throw UsageError("--depth of an evaluation tree is at most 24");
+        draw_tree(a, o.depth, o.output, o.size);
+        return 0;
+    }
+    if (method == "chaos") {
+        rt::ChaosOptions co;
+        co.width = o.size;
+        co.points = static_cast<std::uint64_t>(o.size) * static_cast<std::uint64_t>(o.size) * 8;
+        const rt::Density d = runtime_job([&] { return rt::chaos_game(a, co); });
+        rt::write_density_png(d, o.output);
+        std::cout << fmt::format("wrote {} (chaos game of {}: {} points, seed {})\n", o.output, info.name,
+                                 d.recorded, co.seed);
+        return 0;
+    }
+    // A cover by cell graphs (seed 000 sec. 2.4) in the box of the attractor's proven bounding ball:
+    // grid level depth - 3, then 3 refinements of the kept cells.
+    if (o.depth < 3 || o.depth > 14) throw UsageError("--depth of an attractor cover is 3 to 14");
+    rt::AttractorCoverOptions co;
+    co.refinements = 3;
+    co.initial_level = o.depth - co.refinements;
+    write_cover(runtime_job([&] { return rt::automaton_attractor_cover(a, {}, co); }), o, info.name);
+    return 0;
+}
+
+int render_map(front::Compilation& c, const front::Item& map, const RenderOptions& o,
+               const EngineOptions& engine) {
+    if (o.output.empty()) throw UsageError("render of a map needs -o FILE.png or FILE.svg");
+    if (o.box.empty())
+        throw UsageError(fmt::format(
+            "the attractor of the map '{}' is covered inside a box: give --box x0:x1,y0:y1", map.name));
+    if (o.depth < 3 || o.depth > 14) throw UsageError("--depth of an attractor cover is 3 to 14");
+    const std::vector<ir::Interval> box = parse_box(o.box, 2);
+    std::vector<ir::NodeId> components;
+    try {
+        components = front::lower_point_map(c.program, c.typed, c.sources, {}, c.module, map, 2);
+    } catch (const front::CompileError& e) {
+        c.diags.error(e.loc, e.what());
+        std::cerr << c.diags.render(c.sources);
+        return front::exit_compile_error;
+    }
+    std::vector<std::unique_ptr<ir::Evaluator>> evaluators;
+    std::vector<ir::Evaluator*> parts;
+    for (ir::NodeId n : components) {
+        evaluators.push_back(make_evaluator(c.module, n, 2, engine));
+        parts.push_back(evaluators.back().get());
+    }
+    rt::AttractorCoverOptions co;
+    co.refinements = 3;
+    co.initial_level = o.depth - co.refinements;
+    write_cover(runtime_job([&] { return rt::map_attractor_cover(parts, box, co); }), o, map.name);
+    return 0;
+}
+
+int automaton_dimension(const front::AutomatonInfo& info, int from, int to) {
+    const rt::SimilarityDimension d = runtime_job([&] { return rt::similarity_dimension(info.automaton); });
+    if (d.defined) {
+        std::cout << fmt::format("similarity dimension of {}: {:.12f} in [{:.15f}, {:.15f}] ({})\n",
+                                 info.name, d.value, d.bracket.lo, d.bracket.hi, d.method);
+        return 0;
+    }
+    // Maps that are not similitudes: box counting of the chaos-game cover.
+    std::cout << fmt::format("{} has no similarity dimension: {}\n", info.name, d.reason);
+    if (to > 12) throw UsageError("the chaos-game cover of an automaton goes to --to 12 at most");
+    rt::ChaosOptions co;
+    co.points = std::uint64_t{1} << std::min(2 * to + 4, 30);
+    const rt::Cover cover = runtime_job([&] { return rt::chaos_cover(info.automaton, to, co, false); });
+    const rt::DimensionEstimate e = runtime_job([&] { return rt::box_counting(cover, from, to); });
+    for (const auto& [level, count] : e.counts)
+        std::cout << fmt::format("level {:2}: {} boxes\n", level, count);
+    std::cout << fmt::format(
+        "box-counting dimension of {} (chaos game, {} points): {:.4f} (r^2 = {:.5f}, levels "
+        "{}..{})\n",
+        info.name, co.points, e.dimension, e.r_squared, from, to);
+    return 0;
+}
+
+} // namespace frac::cli

@@ -1,0 +1,435 @@
+#include "runtime/automata/attractor_cover.hpp"
+
+#include "runtime/automata/distance.hpp"
+#include "runtime/rss.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <fmt/format.h>
+#include <functional>
+#include <stdexcept>
+
+namespace frac::rt {
+
+std::vector<bool> recurrent_vertices(const std::vector<std::uint64_t>& offsets,
+                                     const std::vector<std::uint32_t>& targets) {
+    const std::size_t n = offsets.empty() ? 0 : offsets.size() - 1;
+    constexpr std::uint32_t unvisited = UINT32_MAX;
+    std::vector<std::uint32_t> index(n, unvisited), low(n, 0);
+    std::vector<bool> on_stack(n, false), recurrent(n, false);
+    std::vector<std::uint32_t> stack;                          // Tarjan's stack of vertices
+    std::vector<std::pair<std::uint32_t, std::uint64_t>> call; // (vertex, next arc): the recursion, explicit
+    std::uint32_t counter = 0;
+    for (std::size_t root = 0; root < n; ++root) {
+        if (index[root] != unvisited) continue;
+        call.push_back({static_cast<std::uint32_t>(root), offsets[root]});
+        index[root] = low[root] = counter++;
+        stack.push_back(static_cast<std::uint32_t>(root)), on_stack[root] = true;
+        while (!call.empty()) {
+            auto& [v, next] = call.back();
+            if (next < offsets[v + 1]) {
+                const std::uint32_t w = targets[next++];
+                if (index[w] == unvisited) {
+                    index[w] = low[w] = counter++;
+                    stack.push_back(w), on_stack[w] = true;
+                    call.push_back({w, offsets[w]});
+                } else if (on_stack[w]) {
+                    low[v] = std::min(low[v], index[w]);
+                }
+                continue;
+            }
+            const std::uint32_t done = v;
+            call.pop_back();
+            if (!call.empty()) low[call.back().first] = std::min(low[call.back().first], low[done]);
+            if (low[done] != index[done]) continue;
+            // `done` is the root of a component: pop it; several vertices, or a loop, make it recurrent.
+            std::size_t size = 0, first = stack.size();
+            while (true) {
+                const std::uint32_t w = stack[--first];
+                ++size;
+                if (w == done) break;
+            }
+            bool loop = false;
+            if (size == 1)
+                for (std::uint64_t e = offsets[done]; e < offsets[done + 1]; ++e)
+                    loop = loop || targets[e] == done;
+            for (std::size_t i = first; i < stack.size(); ++i) {
+                on_stack[stack[i]] = false;
+                recurrent[stack[i]] = size > 1 || loop;
+            }
+            stack.resize(first);
+        }
+    }
+    return recurrent;
+}
+
+namespace {
+
+using Key = std::uint64_t; // (iz * n + iy) * n + ix at the current level
+
+struct Grid {
+    std::vector<Interval> root; // per axis
+    std::vector<Interval> width;
+};
+
+// A target of an image: a state and the box its cell's image lies in.
+struct Image {
+    std::size_t state;
+    std::array<Interval, 3> box;
+};
+
+// The images of many cells at once: states[i], boxes (d intervals per cell) -> appended to `out`, with
+// `first[i]` the index of cell i's first image (first has one more entry).
+using ImageFn = std::function<void(const std::vector<std::size_t>& states, const std::vector<Interval>& boxes,
+                                   std::vector<Image>& out, std::vector<std::size_t>& first)>;
+
+std::array<std::uint32_t, 3> position(Key k, std::uint64_t n) {
+    return {static_cast<std::uint32_t>(k % n), static_cast<std::uint32_t>((k / n) % n),
+            static_cast<std::uint32_t>(k / n / n)};
+}
+Key key_of(std::uint64_t ix, std::uint64_t iy, std::uint64_t iz, std::uint64_t n) {
+    return (iz * n + iy) * n + ix;
+}
+
+AttractorCoverResult build(int d, const std::vector<Grid>& grids, std::size_t initial, const ImageFn& images,
+                           const AttractorCoverOptions& o) {
+    if (o.initial_level < 0 || o.refinements < 0)
+        throw std::invalid_argument("attractor cover: levels must not be negative");
+    const int last = o.initial_level + o.refinements;
+    if (last > (d == 2 ? max_depth_2d : max_depth_3d) || last > 20)
+        throw std::invalid_argument(fmt::format("attractor cover: level {} is too deep for {}D", last, d));
+    const std::size_t ns = grids.size();
+    AttractorCoverResult out;
+    out.root = grids[initial].root;
+    out.split = 2;
+    out.depth = last;
+    out.levels.assign(static_cast<std::size_t>(last + 1), {});
+    std::vector<std::vector<Cell>> level_cells(static_cast<std::size_t>(last + 1));
+
+    // The kept cells of every state, sorted keys; first every cell of the initial grid.
+    std::uint64_t n = std::uint64_t(1) << o.initial_level;
+    const std::uint64_t all = d == 2 ? n * n : n * n * n;
+    if (all * ns > o.max_cells)
+        throw std::runtime_error(
+            fmt::format("attractor cover: the first grid (level {}) has {} cells, over the "
+                        "budget of {} (max_cells)",
+                        o.initial_level, all * ns, o.max_cells));
+    std::vector<std::vector<Key>> kept(ns);
+    for (auto& k : kept) {
+        k.resize(all);
+        for (Key i = 0; i < all; ++i) k[i] = i;
+    }
+
+    for (int level = o.initial_level; level <= last; ++level) {
+        const auto t0 = std::chrono::steady_clock::now();
+        CoverStep step;
+        step.level = level;
+        std::vector<std::size_t> base(ns + 1, 0); // vertex ids: base[s] + index in kept[s]
+        for (std::size_t s = 0; s < ns; ++s) base[s + 1] = base[s] + kept[s].size();
+        const std::size_t total = base[ns];
+        step.cells = total;
+        if (total > o.max_cells || total >= UINT32_MAX)
+            throw std::runtime_error(
+                fmt::format("attractor cover: level {} has {} cells, over the budget of {} "
+                            "(max_cells)",
+                            level, total, o.max_cells));
+        num::UpwardRounding up;
+        auto cell_box = [&](std::size_t s, Key k, int axis) {
+            const auto p = position(k, n);
+            return grid::cell(grids[s].root[static_cast<std::size_t>(axis)],
+                              grids[s].width[static_cast<std::size_t>(axis)],
+                              p[static_cast<std::size_t>(axis)], n);
+        };
+
+        // Arcs, built in chunks of cells (the images of a chunk are computed in one batch).
+        std::vector<std::uint64_t> offsets{0};
+        std::vector<std::uint32_t> targets;
+        offsets.reserve(total + 1);
+        constexpr std::size_t chunk = 8192;
+        std::vector<std::size_t> states, first;
+        std::vector<Interval> boxes;
+        std::vector<Image> imgs;
+        std::size_t s_at = 0, i_at = 0; // the next cell: state and index
+        while (s_at < ns) {
+            states.clear(), boxes.clear(), imgs.clear(), first.clear();
+            std::vector<std::pair<std::size_t, std::size_t>> cells;
+            while (s_at < ns && cells.size() < chunk) {
+                if (i_at >= kept[s_at].size()) {
+                    ++s_at, i_at = 0;
+                    continue;
+                }
+                cells.push_back({s_at, i_at});
+                states.push_back(s_at);
+                for (int a = 0; a < d; ++a) boxes.push_back(cell_box(s_at, kept[s_at][i_at], a));
+                ++i_at;
+            }
+            if (cells.empty()) break;
+            images(states, boxes, imgs, first);
+            const num::UpwardRounding again; // evaluators may have changed the rounding mode
+            for (std::size_t c = 0; c < cells.size(); ++c) {
+                for (std::size_t m = first[c]; m < first[c + 1]; ++m) {
+                    Image& img = imgs[m];
+                    const Grid& g = grids[img.state];
+                    // Candidate index range per axis (one cell of margin; the exact test follows).
+                    std::array<std::uint64_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
+                    bool empty = false;
+                    for (int a = 0; a < d; ++a) {
+                        Interval& b = img.box[static_cast<std::size_t>(a)];
+                        const Interval r = g.root[static_cast<std::size_t>(a)];
+                        // A NaN bound says nothing: the image may reach anywhere along this axis.
+                        if (std::isnan(b.lo)) b.lo = -num::inf;
+                        if (std::isnan(b.hi)) b.hi = num::inf;
+                        if (b.is_empty() || b.hi < r.lo || b.lo > r.hi) {
+                            empty = true;
+                            break;
+                        }
+                        const double scale = static_cast<double>(n) / (r.hi - r.lo);
+                        const double fl = std::floor((std::max(b.lo, r.lo) - r.lo) * scale) - 1;
+                        const double fh = std::floor((std::min(b.hi, r.hi) - r.lo) * scale) + 1;
+                        lo[static_cast<std::size_t>(a)] = static_cast<std::uint64_t>(std::max(0.0, fl));
+                        hi[static_cast<std::size_t>(a)] = static_cast<std::uint64_t>(
+                            std::min(static_cast<double>(n - 1), std::max(0.0, fh)));
+                    }
+                    if (empty) continue;
+                    const std::vector<Key>& tk = kept[img.state];
+                    for (std::uint64_t iz = lo[2]; iz <= hi[2]; ++iz)
+                        for (std::uint64_t iy = lo[1]; iy <= hi[1]; ++iy) {
+                            const Key from = key_of(lo[0], iy, iz, n), to = key_of(hi[0], iy, iz, n);
+                            for (auto it = std::lower_bound(tk.begin(), tk.end(), from);
+                                 it != tk.end() && *it <= to; ++it) {
+                                bool meets = true;
+                                for (int a = 0; a < d && meets; ++a) {
+                                    const Interval cb = cell_box(img.state, *it, a);
+                                    const Interval b = img.box[static_cast<std::size_t>(a)];
+                                    meets = cb.lo <= b.hi && b.lo <= cb.hi;
+                                }
+                                if (meets)
+                                    targets.push_back(
+                                        static_cast<std::uint32_t>(base[img.state] + (it - tk.begin())));
+                            }
+                        }
+                    if (targets.size() > o.max_arcs)
+                        throw std::runtime_error(
+                            fmt::format("attractor cover: level {} has more than {} arcs "
+                                        "(max_arcs)",
+                                        level, o.max_arcs));
+                }
+                offsets.push_back(targets.size());
+            }
+        }
+        step.arcs = targets.size();
+        const std::vector<bool> rec = recurrent_vertices(offsets, targets);
+
+        // Record the initial state's cells of this level, then split the kept cells of every state.
+        const std::uint64_t per_axis = n;
+        double cell_volume = 1;
+        for (int a = 0; a < d; ++a)
+            cell_volume *= (grids[initial].root[static_cast<std::size_t>(a)].hi -
+                            grids[initial].root[static_cast<std::size_t>(a)].lo) /
+                           static_cast<double>(per_axis);
+        std::vector<Cell>& lc = level_cells[static_cast<std::size_t>(level)];
+        LevelCounts& counts = out.levels[static_cast<std::size_t>(level)];
+        for (std::size_t i = 0; i < kept[initial].size(); ++i) {
+            const bool keep = rec[base[initial] + i];
+            const auto p = position(kept[initial][i], n);
+            lc.push_back(
+                {static_cast<std::uint8_t>(level),
+                 keep ? (level == last ? CellClass::boundary : CellClass::subdivided) : CellClass::outside,
+                 p[0], p[1], p[2]});
+            ++counts.evaluated;
+            if (keep)
+                ++counts.undecided, ++step.kept;
+            else
+                ++counts.outside;
+        }
+        step.area = static_cast<double>(step.kept) * cell_volume;
+        for (std::size_t s = 0; s < ns; ++s) {
+            std::vector<Key> next;
+            for (std::size_t i = 0; i < kept[s].size(); ++i) {
+                if (!rec[base[s] + i]) continue;
+                if (level == last) {
+                    next.push_back(kept[s][i]);
+                    continue;
+                }
+                const auto p = position(kept[s][i], n);
+                for (std::uint64_t c = 0; c < (d == 2 ? 4u : 8u); ++c)
+                    next.push_back(key_of(2 * p[0] + (c & 1), 2 * p[1] + ((c >> 1) & 1),
+                                          d == 2 ? 0 : 2 * p[2] + ((c >> 2) & 1), 2 * n));
+            }
+            std::sort(next.begin(), next.end());
+            kept[s] = std::move(next);
+        }
+        step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        out.steps.push_back(step);
+        if (level < last) n *= 2;
+    }
+
+    // Ancestors of the first graph's cells, above it: subdivided.
+    {
+        std::vector<Key> keys;
+        const std::uint64_t n0 = std::uint64_t(1) << o.initial_level;
+        for (const Cell& c : level_cells[static_cast<std::size_t>(o.initial_level)])
+            if (c.cls != CellClass::outside) keys.push_back(key_of(c.ix, c.iy, c.iz, n0));
+        // Outside cells of the first level are kept only under a listed parent.
+        for (int level = o.initial_level - 1; level >= 0; --level) {
+            const std::uint64_t m = std::uint64_t(1) << level;
+            for (Key& k : keys) {
+                const auto p = position(k, 2 * m);
+                k = key_of(p[0] / 2, p[1] / 2, p[2] / 2, m);
+            }
+            std::sort(keys.begin(), keys.end());
+            keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+            LevelCounts& counts = out.levels[static_cast<std::size_t>(level)];
+            for (Key k : keys) {
+                const auto p = position(k, m);
+                level_cells[static_cast<std::size_t>(level)].push_back(
+                    {static_cast<std::uint8_t>(level), CellClass::subdivided, p[0], p[1], p[2]});
+                ++counts.evaluated, ++counts.undecided;
+            }
+        }
+        if (o.initial_level > 0) {
+            // Drop outside cells of the first graph whose parent is not listed.
+            std::vector<Key> parents;
+            const std::uint64_t m = n0 / 2;
+            for (const Cell& c : level_cells[static_cast<std::size_t>(o.initial_level - 1)])
+                parents.push_back(key_of(c.ix, c.iy, c.iz, m));
+            std::vector<Cell>& lc = level_cells[static_cast<std::size_t>(o.initial_level)];
+            LevelCounts& counts = out.levels[static_cast<std::size_t>(o.initial_level)];
+            std::erase_if(lc, [&](const Cell& c) {
+                if (c.cls != CellClass::outside) return false;
+                const bool orphan = !std::binary_search(parents.begin(), parents.end(),
+                                                        key_of(c.ix / 2, c.iy / 2, c.iz / 2, m));
+                if (orphan) --counts.outside, --counts.evaluated;
+                return orphan;
+            });
+        }
+    }
+    for (std::size_t l = 0; l < level_cells.size(); ++l) {
+        for (const Cell& c : level_cells[l]) {
+            ++out.evaluated;
+            switch (c.cls) {
+            case CellClass::outside: ++out.outside; break;
+            case CellClass::boundary: ++out.boundary; break;
+            case CellClass::subdivided: ++out.subdivided; break;
+            case CellClass::inside: ++out.inside; break;
+            }
+            out.cells.push_back(c);
+        }
+    }
+    return out;
+}
+
+Grid make_grid(const std::vector<Interval>& root) {
+    Grid g;
+    g.root = root;
+    num::UpwardRounding up;
+    for (const Interval& r : root) g.width.push_back(grid::width(r));
+    return g;
+}
+
+void check_root(const std::vector<Interval>& root, int d) {
+    if (static_cast<int>(root.size()) != d || (d != 2 && d != 3))
+        throw std::invalid_argument(
+            fmt::format("attractor cover: the box has {} axes, the map {}", root.size(), d));
+    for (const Interval& r : root)
+        if (!std::isfinite(r.lo) || !std::isfinite(r.hi) || !(r.lo < r.hi))
+            throw std::invalid_argument("attractor cover: every axis of the box must be finite with lo < hi");
+}
+
+} // namespace
+
+AttractorCoverResult map_attractor_cover(const std::vector<ir::Evaluator*>& components,
+                                         const std::vector<Interval>& root,
+                                         const AttractorCoverOptions& options) {
+    const int d = static_cast<int>(components.size());
+    check_root(root, d);
+    for (ir::Evaluator* e : components)
+        if (!e || e->dimension() != d)
+            throw std::invalid_argument(
+                fmt::format("attractor cover: each component must take {} coordinates", d));
+    std::vector<Interval> values;
+    const ImageFn images = [&](const std::vector<std::size_t>& states, const std::vector<Interval>& boxes,
+                               std::vector<Image>& out, std::vector<std::size_t>& first) {
+        const std::size_t count = states.size();
+        values.resize(count);
+        out.resize(count);
+        for (int a = 0; a < d; ++a) {
+            components[static_cast<std::size_t>(a)]->eval_boxes(boxes.data(), count, values.data());
+            for (std::size_t i = 0; i < count; ++i) out[i].box[static_cast<std::size_t>(a)] = values[i];
+        }
+        first.resize(count + 1);
+        for (std::size_t i = 0; i <= count; ++i) first[i] = i;
+        for (Image& img : out) img.state = 0;
+    };
+    return build(d, {make_grid(root)}, 0, images, options);
+}
+
+AttractorCoverResult automaton_attractor_cover(const ir::Automaton& a, const std::vector<Interval>& root,
+                                               const AttractorCoverOptions& options) {
+    if (a.states.empty() || a.initial >= a.states.size())
+        throw std::invalid_argument("attractor cover: automaton without states");
+    const int d = a.states[a.initial].space.dimension;
+    for (const ir::State& s : a.states)
+        if (s.space.kind != ir::Space::Kind::euclidean || s.space.dimension != d || (d != 2 && d != 3))
+            throw std::invalid_argument(
+                fmt::format("attractor cover of automaton '{}': every state must be R2, or "
+                            "every state R3 (state '{}' is {}); barycentric systems are "
+                            "drawn with the tree or the chaos game",
+                            a.name, s.name, ir::space_name(s.space)));
+    // Boxes around the proven bounding balls for the states (also checks the operators and that the
+    // system contracts); the initial state's box is the caller's when given.
+    const std::vector<StateBall> balls = bounding_balls(a);
+    if (balls[a.initial].radius < 0)
+        throw std::invalid_argument(fmt::format("attractor cover: the attractor of '{}' is empty", a.name));
+    std::vector<Grid> grids(a.states.size());
+    {
+        num::UpwardRounding up;
+        for (std::size_t s = 0; s < a.states.size(); ++s) {
+            std::vector<Interval> box;
+            const double r = std::max(balls[s].radius, 0.0);
+            for (int i = 0; i < d; ++i) {
+                const double c = balls[s].radius < 0 ? 0.0 : balls[s].centre[static_cast<std::size_t>(i)];
+                box.push_back({num::sub(Interval(c), Interval(r)).lo, num::add(Interval(c), Interval(r)).hi});
+                if (!(box.back().lo < box.back().hi)) box.back() = {c - 1, c + 1}; // a point attractor
+            }
+            grids[s] = make_grid(s == a.initial && !root.empty() ? root : box);
+        }
+    }
+    check_root(grids[a.initial].root, d);
+    // Arcs in the direction of the points: x in A_b gives T x in A_a for an arc a -> b; states whose
+    // attractor is empty get no cells' images (their vertices stay transient).
+    std::vector<std::vector<std::size_t>> into(a.states.size()); // arcs a -> b, by b
+    for (std::size_t i = 0; i < a.arcs.size(); ++i)
+        if (balls[a.arcs[i].from].radius >= 0 && balls[a.arcs[i].to].radius >= 0)
+            into[a.arcs[i].to].push_back(i);
+    const ImageFn images = [&](const std::vector<std::size_t>& states, const std::vector<Interval>& boxes,
+                               std::vector<Image>& out, std::vector<std::size_t>& first) {
+        num::UpwardRounding up;
+        first.assign(1, 0);
+        for (std::size_t c = 0; c < states.size(); ++c) {
+            for (std::size_t i : into[states[c]]) {
+                const num::Matrix<Interval>& m = a.arcs[i].op.enclosure;
+                Image img;
+                img.state = a.arcs[i].from;
+                for (int r = 0; r < d; ++r) {
+                    Interval v = m(static_cast<std::size_t>(r), static_cast<std::size_t>(d));
+                    for (int k = 0; k < d; ++k)
+                        v = num::add(
+                            v,
+                            num::mul(m(static_cast<std::size_t>(r), static_cast<std::size_t>(k)),
+                                     boxes[c * static_cast<std::size_t>(d) + static_cast<std::size_t>(k)]));
+                    img.box[static_cast<std::size_t>(r)] = v;
+                }
+                out.push_back(img);
+            }
+            first.push_back(out.size());
+        }
+    };
+    // Vertices of states the initial one does not reach have no images, so they are transient after
+    // the first graph and cost nothing later.
+    return build(d, grids, a.initial, images, options);
+}
+
+} // namespace frac::rt
