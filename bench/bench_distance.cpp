@@ -109,8 +109,8 @@ int main(int argc, char** argv) {
                    r.nodes / static_cast<std::uint64_t>(points), r.bb_s, r.brute_s / r.bb_s, r.max_width,
                    r.agree ? "yes" : "NO");
 
-    auto c =
-        driver::compile_source("henon.frac", "shape hx(x, y) = 1 + y - 1.4 * x^2;\nshape hy(x, y) = 0.3 * x;");
+    auto c = driver::compile_source("henon.frac",
+                                    "shape hx(x, y) = 1 + y - 1.4 * x^2;\nshape hy(x, y) = 0.3 * x;");
     if (!c->ok()) {
         std::cerr << c->diags.render(c->sources);
         return 1;
