@@ -8,8 +8,45 @@
 #include <fmt/format.h>
 #include <iostream>
 #include <map>
+#include <pthread.h>
+
+namespace {
+
+int run(int argc, char** argv);
+
+// The passes over syntax trees and graphs recurse along the nesting of expressions, and a model may nest
+// deeply (a chain of thousands of `+` or `min` is a left-deep tree): the work runs on a thread whose stack
+// is large enough for the parser's limits (address space only; pages are touched as used).
+constexpr std::size_t work_stack_bytes = std::size_t{1} << 30;
+
+struct Work {
+    int argc;
+    char** argv;
+    int status = 0;
+};
+
+} // namespace
 
 int main(int argc, char** argv) {
+    Work work{argc, argv};
+    pthread_attr_t attr;
+    pthread_t thread;
+    const auto body = [](void* w) -> void* {
+        auto* job = static_cast<Work*>(w);
+        job->status = run(job->argc, job->argv);
+        return nullptr;
+    };
+    if (pthread_attr_init(&attr) != 0 || pthread_attr_setstacksize(&attr, work_stack_bytes) != 0 ||
+        pthread_create(&thread, &attr, body, &work) != 0)
+        return run(argc, argv); // no large stack to be had: run on the main thread
+    pthread_join(thread, nullptr);
+    pthread_attr_destroy(&attr);
+    return work.status;
+}
+
+namespace {
+
+int run(int argc, char** argv) {
     using namespace frac;
     CLI::App app{"frac: fractal geometric modeling with guaranteed interval evaluation", "frac"};
     app.require_subcommand(1);
@@ -267,3 +304,5 @@ int main(int argc, char** argv) {
     }
     return 0;
 }
+
+} // namespace

@@ -63,12 +63,23 @@ std::string Diagnostics::render(const SourceManager& sm) const {
                                d.message);
         else
             out += fmt::format("{}: {}\n", kind, d.message);
-        const std::string line = sm.line_text(d.loc);
+        std::string line = sm.line_text(d.loc);
         if (!line.empty()) {
-            out += "  " + line + "\n";
-            std::string caret = "  ";
-            for (std::uint32_t c = 1; c < d.loc.column && c - 1 < line.size(); ++c)
-                caret += line[c - 1] == '\t' ? '\t' : ' ';
+            // A long line is quoted by an excerpt around the column, so one error prints a bounded text.
+            constexpr std::size_t max_quote = 160, before = 60;
+            std::size_t column = d.loc.column > 0 ? d.loc.column - 1 : 0;
+            std::string prefix;
+            if (line.size() > max_quote) {
+                const std::size_t start = column > before ? column - before : 0;
+                line = line.substr(start, max_quote) + (start + max_quote < line.size() ? " ..." : "");
+                if (start > 0) {
+                    prefix = "... ";
+                    column = column - start;
+                }
+            }
+            out += "  " + prefix + line + "\n";
+            std::string caret = "  " + std::string(prefix.size(), ' ');
+            for (std::size_t c = 0; c < column && c < line.size(); ++c) caret += line[c] == '\t' ? '\t' : ' ';
             out += caret + "^\n";
         }
     }

@@ -30,9 +30,15 @@ bool read_file(const std::string& path, std::string& text, std::string& why) {
         why = std::strerror(errno);
         return false;
     }
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    text = ss.str();
+    // At most one byte over the limit is read, so a device without end (/dev/zero) stops at the limit;
+    // a failed read (/proc/self/mem) is an error, not an empty file.
+    text.assign(max_file_bytes + 1, '\0');
+    in.read(text.data(), static_cast<std::streamsize>(text.size()));
+    if (in.bad()) {
+        why = "read error";
+        return false;
+    }
+    text.resize(static_cast<std::size_t>(in.gcount()));
     if (text.size() > max_file_bytes) {
         why = fmt::format("larger than the limit of {} MiB", max_file_bytes >> 20);
         return false;

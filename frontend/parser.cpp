@@ -16,6 +16,7 @@ public:
         Program p;
         while (!at(Tok::end)) {
             depth_ = 0;
+            operators_ = 0;
             try {
                 p.items.push_back(item());
             } catch (const CompileError& e) {
@@ -315,6 +316,10 @@ private:
         return e;
     }
     ExprPtr binary(Tok op, Location loc, ExprPtr a, ExprPtr b) {
+        // A chain a + b + c ... is a left-deep tree: every later pass recurses along it.
+        if (++operators_ > max_operators)
+            throw CompileError(
+                loc, fmt::format("this definition has more than {} operators, the limit", max_operators));
         auto e = make(ExprKind::binary, loc);
         e->op = op;
         e->kids.push_back(std::move(a));
@@ -602,11 +607,13 @@ private:
     }
 
     static constexpr int max_nesting = 200;
-    std::set<std::string> aliases_; // of this file's qualified imports so far
+    static constexpr int max_operators = 200000; // binary operators per definition
+    std::set<std::string> aliases_;              // of this file's qualified imports so far
     const std::vector<Token>& t_;
     Diagnostics& diags_;
     std::size_t pos_ = 0;
     int depth_ = 0;
+    int operators_ = 0;
 };
 
 } // namespace

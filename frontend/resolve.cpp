@@ -142,6 +142,12 @@ private:
         checked_ = &it;
         scopes_.clear();
         scopes_.emplace_back();
+        // The box after `over` is a constant: the shape's coordinates are not in its scope.
+        if (it.over) {
+            over_of_ = &it;
+            expr(*it.over);
+            over_of_ = nullptr;
+        }
         for (std::size_t k = 0; k < it.params.size(); ++k) {
             const Param& p = it.params[k];
             const int arity = it.kind == ItemKind::fn ? signatures_.at(&it)[k].arity : value;
@@ -150,7 +156,6 @@ private:
         }
         if (it.kind == ItemKind::shape && !it.has_params)
             for (const char* c : {"x", "y", "z"}) scopes_.back().emplace(c, value);
-        if (it.over) expr(*it.over);
         if (it.body) expr(*it.body);
         for (const Expect& e : it.expects) {
             expr(*e.expr);
@@ -422,6 +427,17 @@ private:
     // An unknown name: the closest known one when it is a likely misspelling, and the standard library
     // module that defines the name when the model does not import it.
     void unknown(Location loc, const char* what, const std::string& name) {
+        if (over_of_) {
+            const bool coordinate = std::any_of(over_of_->params.begin(), over_of_->params.end(),
+                                                [&](const Param& p) { return p.name == name; }) ||
+                                    (!over_of_->has_params && (name == "x" || name == "y" || name == "z"));
+            if (coordinate) {
+                d_.error(loc,
+                         fmt::format("the box after 'over' is a constant: '{}' is a coordinate of shape '{}'",
+                                     name, over_of_->name));
+                return;
+            }
+        }
         std::vector<std::string> known;
         for (const auto& scope : scopes_)
             for (const auto& [local_name, kind] : scope) known.push_back(local_name);
@@ -474,6 +490,7 @@ private:
     std::unordered_map<const Item*, std::vector<ParamType>> signatures_;
     const Item* infer_fn_ = nullptr;
     const Item* checked_ = nullptr; // the item whose body is being checked
+    const Item* over_of_ = nullptr; // the shape whose `over` box is being checked
     std::vector<std::unordered_set<std::string>> shadows_;
 };
 
