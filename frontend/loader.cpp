@@ -3,6 +3,7 @@
 #include "frontend/resolve.hpp"
 #include "frontend/suggest.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <chrono>
@@ -137,9 +138,18 @@ private:
 
 class Loader {
 public:
-    Loader(Compilation& c, Program& into, LoadTimes* times) : c_(c), into_(into), times_(times) {}
+    Loader(Compilation& c, Program& into, LoadTimes* times, std::vector<std::string>* loading = nullptr)
+        : c_(c), into_(into), times_(times), loading_(loading ? loading : &own_loading_) {}
 
-    void load(const std::string& name, const std::string& text, const std::filesystem::path& dir) {
+    // `key` names the file for cycles (its canonical path; empty for text without a file).
+    void load(const std::string& name, const std::string& text, const std::filesystem::path& dir,
+              const std::string& key = "") {
+        loading_->push_back(key);
+        struct Pop {
+            std::vector<std::string>* s;
+            ~Pop() { s->pop_back(); }
+        } pop{loading_};
+        if (!key.empty()) seen_.insert(key + " as ");
         const std::uint32_t file = c_.sources.add(name, text);
         using clock = std::chrono::steady_clock;
         const auto t0 = clock::now();
@@ -181,7 +191,16 @@ private:
             std::error_code ec;
             const auto canonical = std::filesystem::weakly_canonical(path, ec);
             key = ec ? path.string() : canonical.string();
-            if (seen_.count(key + " as " + it.alias)) return; // imported already (or a cycle)
+            if (const auto at = std::find(loading_->begin(), loading_->end(), key); at != loading_->end()) {
+                // A file importing, through others, a file that is still being read.
+                std::string chain;
+                for (auto k = at; k != loading_->end(); ++k)
+                    chain += std::filesystem::path(*k).filename().string() + " imports ";
+                c_.diags.error(it.loc, fmt::format("import cycle: {}{}", chain,
+                                                   std::filesystem::path(key).filename().string()));
+                return;
+            }
+            if (seen_.count(key + " as " + it.alias)) return; // imported already
             std::string why;
             if (!read_file(path.string(), text, why)) {
                 c_.diags.error(it.loc, fmt::format("cannot read '{}': {}", path.string(), why));
@@ -190,15 +209,15 @@ private:
             name = path.string();
             module_dir = path.parent_path();
         }
-        if (!seen_.insert(key + " as " + it.alias).second) return; // imported already (or a cycle)
+        if (!seen_.insert(key + " as " + it.alias).second) return; // imported already
         if (it.alias.empty()) {
-            load(name, text, module_dir);
+            load(name, text, module_dir, key);
             return;
         }
         // A qualified module is loaded on its own (its imports too), then its names get the prefix: it
         // shares nothing with the importing files but what they reach through the prefix.
         Program module;
-        Loader(c_, module, times_).load(name, text, module_dir);
+        Loader(c_, module, times_, loading_).load(name, text, module_dir, key);
         Qualifier q(it.alias, module);
         for (Item& m : module.items) {
             q.rename(m);
@@ -209,6 +228,8 @@ private:
     Compilation& c_;
     Program& into_;
     LoadTimes* times_;
+    std::vector<std::string> own_loading_; // the files being read, outermost first
+    std::vector<std::string>* loading_;
     std::set<std::string> seen_;
 };
 
@@ -249,7 +270,10 @@ bool load_file(Compilation& c, const std::string& path, LoadTimes* times) {
         c.diags.error({}, fmt::format("cannot read '{}': {}", path, why));
         return false;
     }
-    Loader(c, c.program, times).load(path, text, std::filesystem::path(path).parent_path());
+    std::error_code ec;
+    const auto canonical = std::filesystem::weakly_canonical(path, ec);
+    Loader(c, c.program, times)
+        .load(path, text, std::filesystem::path(path).parent_path(), ec ? path : canonical.string());
     return true;
 }
 
