@@ -2,6 +2,8 @@
 // of compile(), and to emit().
 #include "driver/pipeline.hpp"
 
+#include "driver/external_functions.hpp"
+
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/jit.hpp"
 #include "frontend/resolve.hpp"
@@ -83,6 +85,8 @@ void run_frontend(front::Compilation& c, const CompileOptions& options) {
     if (options.stop < Stage::lower || resolve_errors) return;
     timed(options.times, stage_name(Stage::lower),
           [&] { front::lower(c.program, c.typed, c.sources, options.limits, c.module, c.diags); });
+    // The runtime's implementations of the graph's external functions (dist): tapes carry them.
+    if (!c.diags.has_errors()) timed(options.times, "bind", [&] { bind_externals(c.module, c.diags); });
     timed(options.times, "verify", [&] {
         if (std::string defect = ir::verify_graph(c.module.graph); !defect.empty())
             throw front::InternalError("malformed expression graph: " + defect);

@@ -30,6 +30,7 @@ constexpr Builtin builtins[] = {
     {"shear", BuiltinKind::transform, 2, 2, Op::Const},
     {"controls", BuiltinKind::controls, 2, 16, Op::Const},
     {"tabulate", BuiltinKind::tabulate, 2, 2, Op::Const},
+    {"dist", BuiltinKind::distance, 2, 2, Op::External},
     {"point", BuiltinKind::primitive, 1, 1, Op::Const},
     {"segment", BuiltinKind::primitive, 2, 2, Op::Const},
     {"polyline", BuiltinKind::primitive, 0, 64, Op::Const},

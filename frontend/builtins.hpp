@@ -21,6 +21,7 @@ enum class BuiltinKind {
     controls,  // controls(P0, ..., Pn-1): the projection of bary(n) by control points
     primitive, // point, segment, polyline, polygon: what a state of an automaton draws
     tabulate,  // tabulate(automaton, t): the point F(t) of its address map, t = i / N^p (tests, print)
+    distance,  // dist(p, automaton): the distance from the point p to the attractor (an external function)
 };
 
 struct Builtin {

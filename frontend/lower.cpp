@@ -124,6 +124,16 @@ public:
             case ItemKind::automaton: break;
             }
         }
+        for (std::size_t k = 0; k < m_.externals.size(); ++k) {
+            auto it = automaton_index_.find(external_items_[k]);
+            if (it == automaton_index_.end()) {
+                d_.error(m_.externals[k].loc,
+                         fmt::format("'dist' needs the automaton '{}', which did not compile",
+                                     m_.externals[k].automaton_name));
+                continue;
+            }
+            m_.externals[k].automaton = it->second;
+        }
     }
 
 private:
@@ -451,8 +461,34 @@ private:
         }
         case BuiltinKind::primitive: break; // only after `primitive` (automaton_info)
         case BuiltinKind::tabulate: return tabulate(e);
+        case BuiltinKind::distance: return distance(e);
         }
         throw InternalError("unknown builtin kind");
+    }
+
+    // dist(p, A): an External node over p's coordinates (padded with 0 to three), one external function
+    // per automaton. The automaton's index is known once automata are lowered (after shapes): run()
+    // fills it in.
+    Value distance(const Expr& e) {
+        const Value pv = expr(*e.args[0].value);
+        const Value av = expr(*e.args[1].value);
+        if (!av.automaton) throw InternalError("dist: not an automaton");
+        std::size_t k = 0;
+        while (k < external_items_.size() && external_items_[k] != av.automaton) ++k;
+        if (k == external_items_.size()) {
+            ExternalUse use;
+            use.kind = ExternalUse::Kind::distance;
+            use.loc = e.loc;
+            use.automaton_name = av.automaton->name;
+            m_.externals.push_back(std::move(use));
+            external_items_.push_back(av.automaton);
+            g_.externals.resize(m_.externals.size());
+        }
+        if (pv.nodes.empty() || pv.nodes.size() > 3)
+            throw InternalError("dist: the point has " + std::to_string(pv.nodes.size()) + " coordinates");
+        NodeId c[3];
+        for (std::size_t i = 0; i < 3; ++i) c[i] = i < pv.nodes.size() ? pv.nodes[i] : g_.constant(0.0);
+        return Value::scalar(g_.external(static_cast<std::int64_t>(k), c[0], c[1], c[2]));
     }
 
     // tabulate(A, t): F(t) at t = i / N^p, N the arcs per state, read as p digits (seed 003, sec. 2).
@@ -899,6 +935,7 @@ private:
     std::unordered_map<std::string, const Item*> globals_;
     std::unordered_map<const Item*, std::size_t> shape_index_;
     std::unordered_map<const Item*, std::size_t> automaton_index_;
+    std::vector<const Item*> external_items_; // the automaton of each of m_.externals
     std::unordered_map<const Item*, std::optional<Value>> consts_;
     std::unordered_set<const Item*> failed_consts_;
 };

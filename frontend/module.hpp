@@ -43,6 +43,16 @@ struct Query {
     int component = 0;                // automaton_point: the coordinate of F(t) asked for
 };
 
+// What an Op::External node of the graph computes; its index in Module::externals is the node's imm.
+// The frontend leaves Graph::externals null: the driver binds an implementation to each (the runtime's
+// distance to an attractor, driver/external_functions.hpp).
+struct ExternalUse {
+    enum class Kind { distance } kind = Kind::distance;
+    Location loc;                                         // the first call
+    std::size_t automaton = static_cast<std::size_t>(-1); // distance: index into Module::automata
+    std::string automaton_name;                           // distance: for messages
+};
+
 enum class ValueKind { scalar, boolean, point, interval, box };
 
 struct Expectation {
@@ -72,6 +82,7 @@ struct Module {
     std::vector<Query> queries;
     std::vector<TestInfo> tests;
     std::vector<PrintInfo> prints;
+    std::vector<ExternalUse> externals;
 
     const ShapeInfo* find_shape(const std::string& name) const {
         for (const ShapeInfo& s : shapes)

@@ -86,7 +86,8 @@ public:
         Interval r = Interval::entire();
         if (n.op == Op::Const) {
             r = n.value;
-        } else if (ir::op_class(n.op) == ir::OpClass::arith || ir::op_class(n.op) == ir::OpClass::logic) {
+        } else if (n.op != Op::External &&
+                   (ir::op_class(n.op) == ir::OpClass::arith || ir::op_class(n.op) == ir::OpClass::logic)) {
             Interval args[3];
             for (int k = 0; k < ir::arity(n.op); ++k) args[k] = enclose(n.args[static_cast<std::size_t>(k)]);
             r = ir::apply_interval(n.op, args, n.imm);

@@ -102,6 +102,8 @@ private:
         switch (n.op) {
         case Op::Index: return {konst(Interval(0.0)), konst(Interval(1.0)), Interval(1.0), {}, {}};
         case Op::State: return unbounded("the orbit point grows without a proven bound");
+        case Op::External:
+            return unbounded("a distance to an attractor that depends on the index has no proven bound");
         case Op::Add:
         case Op::Sub: {
             TermBound x = arg(0), y = arg(1);

@@ -344,6 +344,24 @@ private:
             require_number(expr(*e.args[1].value).type, e.args[1].loc);
             return TValue::of(Type::point(a.size));
         }
+        if (b.kind == BuiltinKind::distance) {
+            if (frames_.back().ctx == Context::constant)
+                fail(e.loc, "'dist' is computed by the runtime: it is not a constant expression");
+            const Type a = expr(*e.args[1].value).type;
+            if (a.kind != Type::Kind::automaton)
+                fail(e.args[1].loc,
+                     fmt::format("'dist' measures the distance to an ifs or cifs, found {}", type_name(a)));
+            const Type p = expr(*e.args[0].value).type;
+            if (p.kind != Type::Kind::point || p.size != a.size)
+                fail(e.args[0].loc,
+                     fmt::format("'dist' needs a point of {} coordinates (the automaton's output dimension), "
+                                 "found {}",
+                                 a.size,
+                                 p.kind == Type::Kind::point
+                                     ? fmt::format("a point of {} coordinates", p.size)
+                                     : type_name(p)));
+            return TValue::of(Type::number());
+        }
         if (b.kind == BuiltinKind::controls) return TValue::of(controls_type(e));
         if (b.kind == BuiltinKind::primitive)
             fail(e.loc,

@@ -226,7 +226,7 @@ NodeId Graph::op(Op op, NodeId a, NodeId b, NodeId c, std::int64_t imm) {
         n.args[static_cast<std::size_t>(i)] = args[i];
         if (wanted) all_const = all_const && is_const(args[i]);
     }
-    if (all_const) return fold(n);
+    if (all_const && op != Op::External) return fold(n);
     // A value compared with itself (the same node: the same real number) needs no interval.
     if (a == b && op_class(op) == OpClass::logic && arity(op) == 2 && op != Op::And && op != Op::Or) {
         const bool holds = op == Op::Le || op == Op::Ge || op == Op::Eq;
@@ -263,6 +263,11 @@ NodeId Graph::series(Op kind, const SeriesData& data, NodeId body, NodeId tail_a
         n.point_tail[3] = b.hi;
     }
     return intern(n);
+}
+
+NodeId Graph::external(std::int64_t index, NodeId a, NodeId b, NodeId c) {
+    if (index < 0) throw std::logic_error("Graph::external: negative index");
+    return op(Op::External, a, b, c, index);
 }
 
 bool Graph::const_integer(NodeId id, std::int64_t& value) const {

@@ -2,6 +2,7 @@
 // always smaller than its user's). Functions and lets are inlined by the frontend before they get here.
 #pragma once
 
+#include "ir/external.hpp"
 #include "numeric/interval.hpp"
 
 #include <array>
@@ -130,7 +131,15 @@ public:
     NodeId series(Op kind, const SeriesData& data, NodeId body, NodeId tail_a, NodeId tail_b,
                   std::vector<NodeId> orbit = {});
 
+    // A call of external function `index` (an index into `externals`) at the point (a, b, c); a 2D
+    // point passes a constant 0 as c. Never folded, even on constants.
+    NodeId external(std::int64_t index, NodeId a, NodeId b, NodeId c);
+
     bool is_const(NodeId id) const { return nodes_[id].op == Op::Const; }
+
+    // The implementations of the External nodes, by their imm. A slot stays null until a driver binds
+    // it (driver/pipeline.cpp); tapes built afterwards carry the bound implementations.
+    std::vector<std::shared_ptr<const ExternalFunction>> externals;
     // True when the node is a thin integer constant; sets `value`.
     bool const_integer(NodeId id, std::int64_t& value) const;
 
@@ -150,6 +159,9 @@ private:
 
 // Text form of the sub-graph reachable from `roots`, one node a line ("%4 = add %2, %3").
 std::string print_graph(const Graph& g, const std::vector<NodeId>& roots);
+// " #k name" of external function k, for the printers of the graph and the tape.
+std::string external_text(std::int64_t index,
+                          const std::vector<std::shared_ptr<const ExternalFunction>>& table);
 // The text of an escape certificate, for the printers of the graph and the tape.
 std::string escape_text(const OrbitEscape& e);
 

@@ -8,6 +8,13 @@
 
 namespace frac::ir {
 
+std::string external_text(std::int64_t index,
+                          const std::vector<std::shared_ptr<const ExternalFunction>>& table) {
+    const auto k = static_cast<std::size_t>(index);
+    const bool bound = index >= 0 && k < table.size() && table[k];
+    return fmt::format(" #{} {}", index, bound ? table[k]->name() : std::string("(unbound)"));
+}
+
 std::string escape_text(const OrbitEscape& e) {
     std::string s =
         fmt::format(" escape |q| > {}: terms >= ({} (|q| - {}) + {}) * [{}, {}] / [{}, {}]^i", e.radius,
@@ -52,6 +59,7 @@ std::string print_graph(const Graph& g, const std::vector<NodeId>& roots) {
             for (int i = 0; i < arity(n.op); ++i)
                 out += fmt::format("{} %{}", i ? "," : "", n.args[static_cast<std::size_t>(i)]);
             if (n.op == Op::PowI) out += fmt::format(", {}", n.imm);
+            if (n.op == Op::External) out += external_text(n.imm, g.externals);
             break;
         case OpClass::series: {
             const SeriesData& s = n.series;

@@ -41,6 +41,7 @@ Interval apply_interval(Op op, const Interval* a, std::int64_t imm) {
     case Op::Exp: return exp(a[0]);
     case Op::Log: return log(a[0]);
     case Op::Atan2: return atan2(a[0], a[1]);
+    case Op::External: break; // the engines call the tape's function: semantics has no table
     case Op::Lt:
         if (any_empty) return Interval::empty();
         return truth(a[0].hi < a[1].lo, a[0].lo >= a[1].hi);
@@ -103,6 +104,7 @@ double apply_point(Op op, const double* a, std::int64_t imm) {
     case Op::Exp: return std::exp(a[0]);
     case Op::Log: return std::log(a[0]);
     case Op::Atan2: return std::atan2(a[0], a[1]);
+    case Op::External: break;
     case Op::Lt: return a[0] < a[1];
     case Op::Le: return a[0] <= a[1];
     case Op::Gt: return a[0] > a[1];

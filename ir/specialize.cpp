@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 #include <unordered_set>
@@ -221,6 +222,7 @@ public:
         mark(map(t_.result));
         Tape out;
         out.inputs = t_.inputs;
+        out.externals = t_.externals;
         renumber_.assign(t_.num_slots, no_slot);
         for (const TapeConst& c : t_.constants)
             if (live_slot(c.slot)) out.constants.push_back({fresh(c.slot, out), c.value, c.point});
@@ -349,6 +351,8 @@ std::string tape_key(const Tape& t) {
         put(s, c.point);
     }
     for (Slot i : t.input_slots) put(s, i);
+    for (const auto& f : t.externals)
+        put(s, reinterpret_cast<std::uintptr_t>(f.get())); // bound implementations
     for (const auto& b : t.blocks) {
         put(s, b.size());
         for (const Instr& ins : b) {
@@ -387,6 +391,9 @@ double block_cost(const Tape& t, std::uint32_t b) {
     double c = 0;
     for (const Instr& ins : t.blocks[b]) {
         c += 1;
+        // An external function (a branch and bound over an automaton) costs far more than an operation:
+        // pruning it away is worth a compilation sooner.
+        if (ins.op == Op::External) c += 100;
         if (is_series(ins.op)) c += series_terms_estimate * block_cost(t, t.series[ins.series].block);
     }
     return c;

@@ -171,6 +171,7 @@ std::size_t Tape::instruction_count() const {
 Tape build_tape(const Graph& g, NodeId root, int inputs) {
     Tape t;
     t.inputs = inputs;
+    t.externals = g.externals;
     t.input_slots.assign(static_cast<std::size_t>(inputs), no_slot);
     t.result = Scheduler(g, t).run(root);
     return t;
@@ -220,6 +221,7 @@ void print_block(const Tape& t, std::uint32_t b, int indent, std::string& out) {
         for (int i = 0; i < arity(ins.op); ++i)
             out += fmt::format("{} {}", i ? "," : "", slot_name(ins.in[static_cast<std::size_t>(i)]));
         if (ins.op == Op::PowI) out += fmt::format(", {}", ins.imm);
+        if (ins.op == Op::External) out += external_text(ins.imm, t.externals);
         out += "\n";
     }
 }
@@ -250,6 +252,9 @@ std::string verify_block(const Tape& t, std::uint32_t b, std::vector<bool>& writ
                 return fmt::format("block {}: {} reads {} before it is written", b, op_name(ins.op),
                                    slot_name(s));
         }
+        if (ins.op == Op::External &&
+            (ins.imm < 0 || static_cast<std::size_t>(ins.imm) >= t.externals.size()))
+            return fmt::format("block {}: external #{} out of range", b, ins.imm);
         if (is_series(ins.op)) {
             if (ins.series >= t.series.size()) return fmt::format("block {}: bad series index", b);
             const TapeSeries& s = t.series[ins.series];

@@ -56,6 +56,8 @@ struct Tape {
     std::vector<std::vector<Instr>> blocks;
     std::vector<TapeSeries> series;
     Slot result = no_slot;
+    // The graph's external functions (Op::External's imm indexes them); null slots are unbound.
+    std::vector<std::shared_ptr<const ExternalFunction>> externals;
 
     std::size_t instruction_count() const;
 };

@@ -19,6 +19,8 @@ std::string verify_graph(const Graph& g) {
         }
         if (n.op == Op::Index && (n.imm < 1 || n.imm > max_series_level))
             return fmt::format("%{}: bad index level", id);
+        if (n.op == Op::External && (n.imm < 0 || static_cast<std::size_t>(n.imm) >= g.externals.size()))
+            return fmt::format("%{}: external #{} out of range", id, n.imm);
         if (n.op == Op::State && (state_level(n.imm) < 1 || state_level(n.imm) > max_series_level))
             return fmt::format("%{}: bad orbit state", id);
         if (n.orbit.size() != 2 * static_cast<std::size_t>(n.series.state_count))

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace frac::interp {
 
@@ -97,6 +98,14 @@ private:
             if (tape_.input_slots[k] != ir::no_slot) regs[tape_.input_slots[k]] = inputs[k];
     }
 
+    // The implementation of external function k; a tape with an unbound one is a driver bug.
+    const ir::ExternalFunction& external(std::int64_t k) const {
+        const auto i = static_cast<std::size_t>(k);
+        if (i >= tape_.externals.size() || !tape_.externals[i])
+            throw std::logic_error("interpreter: external function #" + std::to_string(k) + " is not bound");
+        return *tape_.externals[i];
+    }
+
     void run_boxes(std::uint32_t block) {
         Interval args[3];
         for (const Instr& ins : tape_.blocks[block]) {
@@ -105,7 +114,8 @@ private:
                 continue;
             }
             for (int i = 0; i < ir::arity(ins.op); ++i) args[i] = boxes_[ins.in[static_cast<std::size_t>(i)]];
-            boxes_[ins.out] = ir::apply_interval(ins.op, args, ins.imm);
+            boxes_[ins.out] = ins.op == Op::External ? external(ins.imm).eval_box(args)
+                                                     : ir::apply_interval(ins.op, args, ins.imm);
         }
     }
 
@@ -118,7 +128,8 @@ private:
             }
             for (int i = 0; i < ir::arity(ins.op); ++i)
                 args[i] = points_[ins.in[static_cast<std::size_t>(i)]];
-            points_[ins.out] = ir::apply_point(ins.op, args, ins.imm);
+            points_[ins.out] = ins.op == Op::External ? external(ins.imm).eval_point(args)
+                                                      : ir::apply_point(ins.op, args, ins.imm);
         }
     }
 

@@ -168,6 +168,12 @@ AotInfo compile_aot(const std::vector<AotShape>& shapes, const AotConfig& config
                     const std::string& object_path, const std::string& llvm_ir_path) {
     for (const AotShape& s : shapes) {
         check_options(s.tape, config.options);
+        for (const auto& block : s.tape.blocks)
+            for (const ir::Instr& ins : block)
+                if (ins.op == ir::Op::External)
+                    throw std::invalid_argument(
+                        "shape '" + s.name +
+                        "' calls dist(...), which needs the runtime: not available in compiled models");
         if (!is_c_identifier(config.prefix + s.name))
             throw std::invalid_argument("'" + config.prefix + s.name + "' is not a C identifier");
         if (static_cast<int>(s.box.size()) != s.tape.inputs)

@@ -71,6 +71,36 @@ SlotState BoxGen::call_core(Op op, std::int64_t imm, const std::vector<const Slo
     return result(call_scalar(name, flat), maybe_empty);
 }
 
+SlotState BoxGen::call_external(std::int64_t k, const SlotState& a, const SlotState& b, const SlotState& c) {
+    Value* f = external_function(k);
+    const bool maybe_empty = a.f.maybe_empty || b.f.maybe_empty || c.f.maybe_empty;
+    const SlotState* args[3] = {&a, &b, &c};
+    if (w_ == 1) {
+        std::vector<Value*> flat = {f};
+        for (const SlotState* s : args) {
+            flat.push_back(s->v.lo);
+            flat.push_back(s->v.hi);
+        }
+        return result(call_scalar("frac_jit_external", flat), maybe_empty);
+    }
+    for (std::size_t i = 0; i < 3; ++i) {
+        b_.CreateStore(args[i]->v.lo, b_.CreateConstInBoundsGEP1_64(dbl_, scratch_in_,
+                                                                    2 * i * static_cast<std::uint64_t>(w_)));
+        b_.CreateStore(args[i]->v.hi, b_.CreateConstInBoundsGEP1_64(
+                                          dbl_, scratch_in_, (2 * i + 1) * static_cast<std::uint64_t>(w_)));
+    }
+    auto callee = m_.getOrInsertFunction(
+        "frac_jit_vexternal",
+        llvm::FunctionType::get(Type::getVoidTy(ctx_), {ptr_, ptr_, ptr_, i32_, i32_}, false));
+    llvm::cast<Function>(callee.getCallee())->setDoesNotThrow();
+    b_.CreateCall(callee, {f, scratch_in_, scratch_out_, mask_bits(ctx_mask_),
+                           b_.getInt32(static_cast<std::uint32_t>(w_))});
+    return result({b_.CreateLoad(vt_, scratch_out_),
+                   b_.CreateLoad(vt_, b_.CreateConstInBoundsGEP1_64(dbl_, scratch_out_,
+                                                                    static_cast<std::uint64_t>(w_)))},
+                  maybe_empty);
+}
+
 // Entry idx (a scalar, the same for every lane) of a table of doubles / of intervals.
 Value* BoxGen::load_scalar(llvm::GlobalVariable* g, Value* idx) {
     return splat(b_.CreateLoad(dbl_, b_.CreateInBoundsGEP(dbl_, g, idx)));

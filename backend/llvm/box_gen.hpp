@@ -268,6 +268,8 @@ private:
     IV call_scalar(const char* helper, std::vector<Value*> args);
     IV call_vector(Op op, std::int64_t imm, const std::vector<IV>& args, Value* mask);
     SlotState call_core(Op op, std::int64_t imm, const std::vector<const SlotState*>& args, bool maybe_empty);
+    // Op::External: the tape's function k, out of line (frac_jit_external, lane by lane in vector code).
+    SlotState call_external(std::int64_t k, const SlotState& a, const SlotState& b, const SlotState& c);
 
     // ---- interval operations: numeric/interval.cpp, step by step ----
     SlotState op_add(const SlotState& a, const SlotState& b);

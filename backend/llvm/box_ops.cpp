@@ -268,6 +268,7 @@ SlotState BoxGen::emit_op(const Instr& ins) {
     case Op::Tan:
     case Op::Exp: return call_core(ins.op, 0, {&in(0)}, in(0).f.maybe_empty);
     case Op::Atan2: return call_core(ins.op, 0, {&in(0), &in(1)}, in(0).f.maybe_empty || in(1).f.maybe_empty);
+    case Op::External: return call_external(ins.imm, in(0), in(1), in(2));
     case Op::Lt:
     case Op::Le:
     case Op::Gt:

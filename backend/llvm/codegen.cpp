@@ -116,6 +116,9 @@ private:
         case Op::Exp: return call("frac_jit_exp_point", {in(0)});
         case Op::Log: return call("frac_jit_log_point", {in(0)});
         case Op::Atan2: return call("frac_jit_atan2_point", {in(0), in(1)});
+        case Op::External:
+            return b_.CreateCall(declare("frac_jit_external_point", dbl_, {ptr_, dbl_, dbl_, dbl_}),
+                                 {external_function(ins.imm), in(0), in(1), in(2)});
         case Op::Lt: return bool_to_double(b_.CreateFCmpOLT(in(0), in(1)));
         case Op::Le: return bool_to_double(b_.CreateFCmpOLE(in(0), in(1)));
         case Op::Gt: return bool_to_double(b_.CreateFCmpOGT(in(0), in(1)));

@@ -1,5 +1,6 @@
 #include "backend/llvm/helpers.hpp"
 
+#include "ir/external.hpp"
 #include "ir/graph.hpp"
 #include "ir/semantics.hpp"
 #include "ir/series_tail.hpp"
@@ -62,6 +63,37 @@ CInterval frac_jit_log(double lo, double hi) noexcept {
 }
 CInterval frac_jit_powi(double lo, double hi, std::int64_t n) noexcept {
     return out(num::powi({lo, hi}, n));
+}
+
+CInterval frac_jit_external(const void* f, double alo, double ahi, double blo, double bhi, double clo,
+                            double chi) noexcept {
+    const num::Interval args[3] = {{alo, ahi}, {blo, bhi}, {clo, chi}};
+    try {
+        return out(static_cast<const frac::ir::ExternalFunction*>(f)->eval_box(args));
+    } catch (...) {
+        return out(num::Interval::entire()); // no exception crosses generated code: nothing is known
+    }
+}
+
+double frac_jit_external_point(const void* f, double a, double b, double c) noexcept {
+    const double args[3] = {a, b, c};
+    try {
+        return static_cast<const frac::ir::ExternalFunction*>(f)->eval_point(args);
+    } catch (...) {
+        return std::nan("");
+    }
+}
+
+void frac_jit_vexternal(const void* f, const double* in, double* out, std::uint32_t mask,
+                        int lanes) noexcept {
+    for (int l = 0; l < lanes; ++l) {
+        CInterval r{0.0, 0.0};
+        if (mask >> l & 1)
+            r = frac_jit_external(f, in[l], in[lanes + l], in[2 * lanes + l], in[3 * lanes + l],
+                                  in[4 * lanes + l], in[5 * lanes + l]);
+        out[l] = r.lo;
+        out[lanes + l] = r.hi;
+    }
 }
 
 void frac_jit_vop(int op, std::int64_t imm, const double* in, double* out, std::uint32_t mask,
@@ -221,6 +253,9 @@ const std::vector<Helper>& helpers() {
         FRAC_HELPER(frac_jit_vcentre),
         FRAC_HELPER(frac_jit_vfinish),
         FRAC_HELPER(frac_jit_escape_point_done),
+        FRAC_HELPER(frac_jit_external),
+        FRAC_HELPER(frac_jit_external_point),
+        FRAC_HELPER(frac_jit_vexternal),
     };
 #undef FRAC_HELPER
     return list;

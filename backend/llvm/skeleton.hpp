@@ -209,6 +209,16 @@ protected:
         return globals_[key] = g;
     }
     // A function of the helpers (helpers.hpp), which throw nothing.
+    // The address of the tape's external function k as a constant: the JIT runs in the process that
+    // owns it (the compiled code keeps the tape, hence the function, alive). AOT refuses External.
+    llvm::Value* external_function(std::int64_t k) {
+        const auto i = static_cast<std::size_t>(k);
+        if (k < 0 || i >= t_.externals.size() || !t_.externals[i])
+            throw std::logic_error("jit: external function #" + std::to_string(k) + " is not bound");
+        return llvm::ConstantExpr::getIntToPtr(
+            b_.getInt64(static_cast<std::uint64_t>(reinterpret_cast<std::uintptr_t>(t_.externals[i].get()))),
+            ptr_);
+    }
     llvm::FunctionCallee declare(const char* name, llvm::Type* ret, const std::vector<llvm::Type*>& args) {
         auto callee = m_.getOrInsertFunction(name, llvm::FunctionType::get(ret, args, false));
         llvm::cast<llvm::Function>(callee.getCallee())->setDoesNotThrow();

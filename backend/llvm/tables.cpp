@@ -159,7 +159,8 @@ bool may_be_empty(Op op, const bool* in, std::int64_t imm, const Facts& divisor)
     case Op::Tan:
     case Op::Exp:
     case Op::Not: return in[0];
-    case Op::Select: return in[0] || in[1] || in[2];
+    case Op::Select:
+    case Op::External: return in[0] || in[1] || in[2]; // AttractorDistanceFunction: empty on empty only
     case Op::PowI:
         return imm < 0 || in[0]; // 1 / 0^n is empty
     // A divisor of known sign cannot be [0, 0].
@@ -198,7 +199,7 @@ Tables build_tables(const Tape& t, const ir::EvalOptions& o) {
         std::vector<const Instr*> chosen;
         for (const Instr& ins : t.blocks[s.block]) {
             if (ir::is_series(ins.op)) continue;
-            bool ok = true;
+            bool ok = ins.op != Op::External; // computed by the runtime: never tabulated at compile time
             for (int k = 0; k < ir::arity(ins.op); ++k) {
                 const Slot in = ins.in[static_cast<std::size_t>(k)];
                 if (!(is_const[in] || in == s.index_slot || index_only[in])) ok = false;

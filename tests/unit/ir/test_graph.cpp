@@ -1,6 +1,10 @@
 #include "ir/graph.hpp"
 #include "ir/tape.hpp"
 
+#include <cmath>
+#include <memory>
+#include <string>
+
 #include <catch2/catch.hpp>
 
 using namespace frac::ir;
@@ -68,4 +72,40 @@ TEST_CASE("the tape verifier catches malformed tapes", "[tape]") {
     Tape twice = t;
     twice.blocks[0].push_back(twice.blocks[0][0]);
     CHECK_FALSE(verify_tape(twice).empty());
+}
+
+namespace {
+// |p|: a stand-in for the runtime's distance, enough for the graph and the tape.
+class Norm final : public ExternalFunction {
+public:
+    int arity() const override { return 2; }
+    Interval eval_box(const Interval* a) const override {
+        return frac::num::sqrt(frac::num::add(frac::num::sqr(a[0]), frac::num::sqr(a[1])));
+    }
+    double eval_point(const double* a) const override { return std::hypot(a[0], a[1]); }
+    std::string name() const override { return "norm"; }
+};
+} // namespace
+
+TEST_CASE("an external call is never folded, and tapes carry the bound implementations", "[graph]") {
+    Graph g;
+    const NodeId zero = g.constant(0.0);
+    g.externals.resize(1);
+    // Constant arguments: still a call (the graph cannot evaluate it).
+    const NodeId c = g.external(0, g.constant(3.0), g.constant(4.0), zero);
+    CHECK(g[c].op == Op::External);
+    CHECK(g.external(0, g.constant(3.0), g.constant(4.0), zero) == c); // hash-consed
+    CHECK(verify_graph(g).empty());
+    CHECK(print_graph(g, {c}).find("external %") != std::string::npos);
+    CHECK(print_graph(g, {c}).find("#0 (unbound)") != std::string::npos);
+    g.externals[0] = std::make_shared<Norm>();
+    const NodeId x = g.external(0, g.var(0), g.var(1), zero);
+    const Tape t = build_tape(g, g.op(Op::Add, x, c), 2);
+    REQUIRE(t.externals.size() == 1);
+    CHECK(t.externals[0] == g.externals[0]);
+    CHECK(verify_tape(t).empty());
+    CHECK(print_tape(t).find("#0 norm") != std::string::npos);
+    // An index outside the table is a malformed graph.
+    g.external(1, g.var(0), g.var(1), zero);
+    CHECK(verify_graph(g).find("external #1 out of range") != std::string::npos);
 }
