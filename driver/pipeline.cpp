@@ -22,6 +22,8 @@ const std::vector<StageInfo>& stages() {
         {Stage::parse, "parse", "the syntax tree of the main file (imports read and parsed)"},
         {Stage::resolve, "resolve", "the definitions every name resolves to"},
         {Stage::typecheck, "typecheck", "the type of every definition and function instance"},
+        {Stage::const_eval, "consteval",
+         "the value of every constant: exact where it is rational, else enclosed"},
         {Stage::lower, "lower", "the expression graph of each shape (constants folded, series bounded)"},
         {Stage::automaton, "automaton", "the automaton IR of each ifs and cifs (lowered with the shapes)"},
         {Stage::tape, "tape", "the instruction tape of each shape"},
@@ -81,10 +83,16 @@ void run_frontend(front::Compilation& c, const CompileOptions& options) {
     const bool resolve_errors = c.diags.has_errors();
     timed(options.times, stage_name(Stage::typecheck),
           [&] { front::typecheck(c.program, options.limits, c.typed, c.diags); });
-    // Lowering runs on what type-checked (typecheck.hpp), so one run reports errors of both stages.
-    if (options.stop < Stage::lower || resolve_errors) return;
-    timed(options.times, stage_name(Stage::lower),
-          [&] { front::lower(c.program, c.typed, c.sources, options.limits, c.module, c.diags); });
+    // Constant evaluation and lowering run on what type-checked (typecheck.hpp), so one run reports
+    // errors of every stage.
+    if (options.stop < Stage::const_eval || resolve_errors) return;
+    timed(options.times, stage_name(Stage::const_eval), [&] {
+        front::evaluate_constants(c.program, c.typed, c.sources, options.limits, c.constants, c.diags);
+    });
+    if (options.stop < Stage::lower) return;
+    timed(options.times, stage_name(Stage::lower), [&] {
+        front::lower(c.program, c.typed, c.sources, options.limits, c.module, c.diags, &c.constants);
+    });
     // The runtime's implementations of the graph's external functions (dist): tapes carry them.
     if (!c.diags.has_errors()) timed(options.times, "bind", [&] { bind_externals(c.module, c.diags); });
     timed(options.times, "verify", [&] {
@@ -204,6 +212,7 @@ std::string emit(const front::Compilation& c, Stage stage, const std::vector<std
     case Stage::parse: return front::print_ast(c.program, main_file);
     case Stage::resolve: return definitions_text(c);
     case Stage::typecheck: return front::print_types(c.program, c.typed, main_file);
+    case Stage::const_eval: return front::print_constants(c.program, c.constants, main_file);
     case Stage::automaton: {
         std::string out;
         for (const front::AutomatonInfo& a : c.module.automata)

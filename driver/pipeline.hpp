@@ -1,6 +1,6 @@
 // The pipeline from source to evaluator, every stage in order (pipeline.cpp holds the list):
 //
-//   lex -> parse -> resolve -> typecheck -> lower (and verify)     (frontend, once per model)
+//   lex -> parse -> resolve -> typecheck -> consteval -> lower (and verify)   (frontend, once per model)
 //   -> automaton                                                   (the automaton IR of each ifs, cifs)
 //   -> tape -> specialize -> codegen                               (backend, per shape)
 //
@@ -17,7 +17,7 @@
 
 namespace frac::driver {
 
-enum class Stage { lex, parse, resolve, typecheck, lower, automaton, tape, specialize, codegen };
+enum class Stage { lex, parse, resolve, typecheck, const_eval, lower, automaton, tape, specialize, codegen };
 
 struct StageInfo {
     Stage stage;

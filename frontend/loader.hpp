@@ -6,6 +6,7 @@
 #include "frontend/ast.hpp"
 #include "frontend/lower.hpp"
 #include "frontend/module.hpp"
+#include "frontend/consteval.hpp"
 #include "frontend/typecheck.hpp"
 
 #include <map>
@@ -21,6 +22,7 @@ struct Compilation {
     std::vector<std::string> unknown_overrides; // overridden constants the model does not define
     Program program;                            // the items of every file, imported files first
     TypedProgram typed;                         // the types of the program (typecheck)
+    ConstantValues constants;                   // the values of its constants (consteval)
     Module module;
     bool ok() const { return !diags.has_errors(); }
 };

@@ -1,6 +1,7 @@
 #include "frontend/lower.hpp"
 
 #include "frontend/builtins.hpp"
+#include "frontend/consteval.hpp"
 #include "frontend/inliner.hpp"
 #include "frontend/operators.hpp"
 #include "frontend/orbit_escape.hpp"
@@ -77,9 +78,25 @@ struct Closure {
 class Lowering : Inliner<Value> {
 public:
     Lowering(const Program& p, const TypedProgram& typed, const SourceManager& sm, const Limits& limits,
-             Module& m, Diagnostics& d)
+             Module& m, Diagnostics& d, const ConstantValues* constants = nullptr)
         : Inliner(limits.max_inline_depth), p_(p), typed_(typed), sm_(sm), limits_(limits), m_(m),
-          g_(m.graph), d_(d) {}
+          g_(m.graph), d_(d), constants_(constants) {}
+
+    // The constant stage (consteval.hpp): each constant lowered into this lowering's own graph and read
+    // back as exact values or enclosures.
+    void evaluate_constants(ConstantValues& out) {
+        declare();
+        for (const Item& it : p_.items) {
+            if (it.kind != ItemKind::const_ || typed_.failed.count(&it)) continue;
+            bool ok = false;
+            guarded([&] {
+                const Value v = const_value(it, it.loc);
+                if (std::optional<ConstantValue> c = constant_of(v)) out.values[&it] = std::move(*c);
+                ok = true;
+            });
+            if (!ok) out.failed.insert(&it);
+        }
+    }
 
     void declare() {
         for (const Item& it : p_.items) {
@@ -203,7 +220,49 @@ private:
         if (!failed_consts_.count(&it)) const_value(it, it.loc); // a failure was reported where it happened
     }
 
+    // A value of the constant stage as graph-independent numbers; nullopt for what it cannot hold (a
+    // builtin or an anonymous function named by a constant), which lowering then lowers itself.
+    std::optional<ConstantValue> constant_of(const Value& v) const {
+        ConstantValue c;
+        c.kind = v.kind;
+        c.box = v.box;
+        c.linear = v.linear;
+        c.item = v.shape ? v.shape : v.function ? v.function : v.automaton;
+        if (v.builtin || v.closure) return std::nullopt;
+        for (NodeId n : v.nodes) {
+            if (!g_.is_const(n)) return std::nullopt;
+            ConstantComponent k;
+            if (const num::Rational* q = g_.exact_value(n))
+                k.exact = std::make_shared<const num::Rational>(*q);
+            k.enclosure = g_[n].value;
+            k.point = g_[n].point;
+            c.components.push_back(std::move(k));
+        }
+        return c;
+    }
+
+    // The value of the constant stage as a lowering value in this graph.
+    Value value_of(const ConstantValue& c) {
+        Value v;
+        v.kind = c.kind;
+        v.box = c.box;
+        v.linear = c.linear;
+        if (c.item) {
+            (c.item->kind == ItemKind::shape       ? v.shape
+             : c.item->kind == ItemKind::automaton ? v.automaton
+                                                   : v.function) = c.item;
+        }
+        for (const ConstantComponent& k : c.components)
+            v.nodes.push_back(k.exact ? g_.constant(*k.exact) : g_.constant(k.enclosure, k.point));
+        return v;
+    }
+
     Value const_value(const Item& it, Location use) {
+        if (constants_) {
+            if (auto c = constants_->values.find(&it); c != constants_->values.end())
+                return value_of(c->second);
+            if (constants_->failed.count(&it)) throw AlreadyReported{};
+        }
         if (failed_consts_.count(&it)) throw AlreadyReported{};
         if (auto c = consts_.find(&it); c != consts_.end()) {
             if (!c->second) fail(use, fmt::format("constant '{}' is defined in terms of itself", it.name));
@@ -932,6 +991,7 @@ private:
     Module& m_;
     ir::Graph& g_;
     Diagnostics& d_;
+    const ConstantValues* constants_ = nullptr;
     std::unordered_map<std::string, const Item*> globals_;
     std::unordered_map<const Item*, std::size_t> shape_index_;
     std::unordered_map<const Item*, std::size_t> automaton_index_;
@@ -943,8 +1003,14 @@ private:
 } // namespace
 
 void lower(const Program& program, const TypedProgram& typed, const SourceManager& sources,
-           const Limits& limits, Module& out, Diagnostics& diags) {
-    Lowering(program, typed, sources, limits, out, diags).run();
+           const Limits& limits, Module& out, Diagnostics& diags, const ConstantValues* constants) {
+    Lowering(program, typed, sources, limits, out, diags, constants).run();
+}
+
+void evaluate_constants(const Program& program, const TypedProgram& typed, const SourceManager& sources,
+                        const Limits& limits, ConstantValues& out, Diagnostics& diags) {
+    Module scratch; // the constants fold in a graph of their own
+    Lowering(program, typed, sources, limits, scratch, diags).evaluate_constants(out);
 }
 
 std::vector<NodeId> lower_point_map(const Program& program, const TypedProgram& typed,

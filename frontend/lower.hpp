@@ -17,8 +17,12 @@ struct Limits {
 
 struct TypedProgram;
 
+struct ConstantValues;
+
+// `constants`: the values of the constant stage (consteval.hpp), used instead of lowering the
+// definitions of constants again; null: constants are lowered where they are used.
 void lower(const Program& program, const TypedProgram& typed, const SourceManager& sources,
-           const Limits& limits, Module& out, Diagnostics& diags);
+           const Limits& limits, Module& out, Diagnostics& diags, const ConstantValues* constants = nullptr);
 
 // A map of the plane or space for dynamical systems (fn henon(p) = (...)): the graph nodes of its
 // components applied to the point (Var(0), ..., Var(dimension - 1)), added to out.graph. Throws
