@@ -4,9 +4,9 @@
 #pragma once
 
 #include "frontend/ast.hpp"
+#include "frontend/consteval.hpp"
 #include "frontend/lower.hpp"
 #include "frontend/module.hpp"
-#include "frontend/consteval.hpp"
 #include "frontend/typecheck.hpp"
 
 #include <map>
