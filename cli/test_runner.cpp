@@ -37,7 +37,7 @@ void run_prints(const front::Compilation& c, const EngineOptions& engine, driver
             break;
         }
         case front::ValueKind::boolean:
-            std::cout << truth_text(driver::evaluate_closed(m, p.nodes[0], engine, answers).enclosure)
+            std::cout << truth_text(driver::evaluate_closed(m, p.nodes[0], engine, answers, false).enclosure)
                       << "\n";
             break;
         case front::ValueKind::scalar:

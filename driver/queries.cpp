@@ -67,7 +67,7 @@ std::vector<ir::Interval> answer_queries(const front::Module& m, const ir::Tape&
 }
 
 ClosedValue evaluate_closed(const front::Module& m, ir::NodeId node, const EngineOptions& engine,
-                            QueryAnswers& answers) {
+                            QueryAnswers& answers, bool with_point) {
     const int inputs = static_cast<int>(m.queries.size());
     const ir::Tape tape = ir::build_tape(m.graph, node, inputs);
     const std::vector<ir::Interval> in = answer_queries(m, tape, engine, answers);
@@ -77,7 +77,7 @@ ClosedValue evaluate_closed(const front::Module& m, ir::NodeId node, const Engin
     for (std::size_t k = 0; k < tape.input_slots.size(); ++k)
         reads_enclosure |=
             tape.input_slots[k] != ir::no_slot && m.queries[k].kind == front::Query::Kind::enclose;
-    if (!reads_enclosure) {
+    if (with_point && !reads_enclosure) {
         std::vector<double> p;
         for (const ir::Interval& x : in) p.push_back(num::midpoint(x));
         v.point = eval->eval_point(p.data());

@@ -30,7 +30,8 @@ struct ClosedValue {
     ir::Interval enclosure;
     std::optional<double> point;
 };
+// `with_point`: also its point value (a truth value needs only its enclosure).
 ClosedValue evaluate_closed(const front::Module& m, ir::NodeId node, const EngineOptions& engine,
-                            QueryAnswers& answers);
+                            QueryAnswers& answers, bool with_point = true);
 
 } // namespace frac::driver

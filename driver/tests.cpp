@@ -12,7 +12,7 @@ TestOutcome run_test(const front::Module& m, const front::TestInfo& test, const 
         ExpectationFailure failure;
         failure.expectation = &x;
         try {
-            failure.truth = evaluate_closed(m, x.truth, engine, answers).enclosure;
+            failure.truth = evaluate_closed(m, x.truth, engine, answers, false).enclosure;
             if (failure.truth == ir::tv_true) continue;
             for (ir::NodeId n : x.shown) failure.shown.push_back(evaluate_closed(m, n, engine, answers));
         } catch (const RunError& e) {

@@ -1,22 +1,14 @@
 // Automata in the language: operators lowered exactly where written exactly, enclosures otherwise,
 // checks located at the arc or state they are about.
-#include "driver/pipeline.hpp"
+#include "compile.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>
 
 using namespace frac;
 using namespace frac::front;
-
-namespace {
-
-std::unique_ptr<Compilation> compile_ok(const std::string& text) {
-    auto c = driver::compile_source("t.frac", text);
-    if (!c->ok()) FAIL(c->diags.render(c->sources));
-    return c;
-}
-
-} // namespace
+using frac::test::compile_ok;
+using frac::test::errors_of;
 
 TEST_CASE("operators are exact where written exactly", "[automata]") {
     auto c =

@@ -1,25 +1,12 @@
-#include "driver/pipeline.hpp"
+#include "compile.hpp"
 #include "ir/tape.hpp"
 
 #include <catch2/catch.hpp>
 
 using namespace frac;
 using namespace frac::front;
-
-namespace {
-
-std::unique_ptr<Compilation> compile_ok(const std::string& text) {
-    auto c = driver::compile_source("t.frac", text);
-    if (!c->ok()) FAIL(c->diags.render(c->sources));
-    return c;
-}
-
-std::string errors_of(const std::string& text) {
-    auto c = driver::compile_source("t.frac", text);
-    return c->diags.render(c->sources);
-}
-
-} // namespace
+using frac::test::compile_ok;
+using frac::test::errors_of;
 
 TEST_CASE("functions and lets are inlined into one hash-consed graph", "[lower]") {
     auto c = compile_ok("fn sq(a) = a * a;\nshape s(x, y) = let d = sq(x) + sq(y) in d - sq(x) - 1;");
