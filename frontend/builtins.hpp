@@ -22,6 +22,7 @@ enum class BuiltinKind {
     primitive, // point, segment, polyline, polygon: what a state of an automaton draws
     tabulate,  // tabulate(automaton, t): the point F(t) of its address map, t = i / N^p (tests, print)
     distance,  // dist(p, automaton): the distance from the point p to the attractor (an external function)
+    dof,       // dof(bcifs.cell): the free entries a cell's operators keep after the constraints (tests)
 };
 
 struct Builtin {
