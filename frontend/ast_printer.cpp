@@ -32,10 +32,9 @@ const char* op_text(Tok op) {
 }
 
 std::string print_factors(const std::vector<FactorDecl>& side) {
-    std::string out;
-    for (const FactorDecl& f : side)
-        out += (out.empty() ? "" : " ") + (f.constant ? print_expr(*f.constant) : f.cell + "." + f.name);
-    return "(" + out + ")";
+    std::vector<std::string> out;
+    for (const FactorDecl& f : side) out.push_back(f.constant ? print_expr(*f.constant) : f.cell + "." + f.name);
+    return fmt::format("({})", fmt::join(out, " "));
 }
 
 std::string print_bcifs(const BcifsDecl& b) {
