@@ -131,7 +131,15 @@ struct ParamDecl {
     ExprPtr lo, hi, value; // each may be null
 };
 
+// topology e = edge(v) split n;  topology f = quad(e) split n x n;  (frontend/topology.hpp)
+struct TopologyDecl {
+    std::string cell, kind, of; // kind: edge or quad; `of`: the boundary cell
+    int n = 2, m = 1;
+    Location loc, kind_loc, of_loc;
+};
+
 struct BcifsDecl {
+    std::vector<TopologyDecl> topologies;
     std::vector<OperatorDecl> operators;
     std::vector<ConstraintDecl> constraints;
     std::vector<FixDecl> fixes;
@@ -185,5 +193,7 @@ Program parse(const std::vector<Token>& tokens, Diagnostics& diags);
 // Only the items of `file` when it is not 0 (imported files' items are left out).
 std::string print_ast(const Program& p, std::uint32_t file = 0);
 std::string print_expr(const Expr& e);
+// A constraint's side as written: e.B0 * v.T0 (a constant factor in its syntax-tree form).
+std::string print_product(const std::vector<FactorDecl>& side);
 
 } // namespace frac::front

@@ -33,7 +33,8 @@ const char* op_text(Tok op) {
 
 std::string print_factors(const std::vector<FactorDecl>& side) {
     std::vector<std::string> out;
-    for (const FactorDecl& f : side) out.push_back(f.constant ? print_expr(*f.constant) : f.cell + "." + f.name);
+    for (const FactorDecl& f : side)
+        out.push_back(f.constant ? print_expr(*f.constant) : f.cell + "." + f.name);
     return fmt::format("({})", fmt::join(out, " "));
 }
 
@@ -54,6 +55,13 @@ std::string print_bcifs(const BcifsDecl& b) {
 }
 
 } // namespace
+
+std::string print_product(const std::vector<FactorDecl>& side) {
+    std::vector<std::string> out;
+    for (const FactorDecl& f : side)
+        out.push_back(f.constant ? print_expr(*f.constant) : f.cell + "." + f.name);
+    return fmt::format("{}", fmt::join(out, " * "));
+}
 
 std::string print_expr(const Expr& e) {
     auto kids = [&](std::size_t from = 0) {

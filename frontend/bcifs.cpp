@@ -169,9 +169,11 @@ std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& sys, Diagnostics& di
                 sys.constraints.empty()                   ? sys.operators.front().loc
                 : solution.conflict.front() < column_sums ? sys.constraints[solution.conflict.front()].loc
                                                           : sys.operators.front().loc,
-                fmt::format("the constraints of bcifs '{}' conflict: no operators satisfy all of these "
-                            "{} together (removing any one of them leaves a solution)",
-                            sys.name, solution.conflict.size()));
+                solution.conflict.size() == 1
+                    ? fmt::format("a constraint of bcifs '{}' cannot hold with these operators", sys.name)
+                    : fmt::format("the constraints of bcifs '{}' conflict: no operators satisfy these {} "
+                                  "together (without any one of them the rest have a solution)",
+                                  sys.name, solution.conflict.size()));
             for (std::size_t s : solution.conflict) {
                 if (s < column_sums) {
                     diags.note(sys.constraints[s].loc, fmt::format("constraint {}", sys.constraints[s].text));

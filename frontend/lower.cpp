@@ -526,6 +526,9 @@ private:
         case BuiltinKind::tabulate: return tabulate(e);
         case BuiltinKind::distance: return distance(e);
         case BuiltinKind::dof: return dof(e);
+        case BuiltinKind::kron:
+            return linear_value(LinearValue::matrix(
+                kronecker(expr(*e.args[0].value).linear->in(0), expr(*e.args[1].value).linear->in(0))));
         }
         throw InternalError("unknown builtin kind");
     }
@@ -762,12 +765,6 @@ private:
         fail(e.loc, "an entry is affine in the parameters: sums of parameters times numbers");
     }
 
-    static std::string factors_text(const std::vector<FactorDecl>& side) {
-        std::vector<std::string> out;
-        for (const FactorDecl& f : side) out.push_back(f.constant ? "(matrix)" : f.cell + "." + f.name);
-        return fmt::format("{}", fmt::join(out, " * "));
-    }
-
     // The constraint system of a bcifs, from its declaration (the type checker checked every size).
     BcifsSystem bcifs_system(const Item& it, const std::function<std::size_t(const std::string&)>& index) {
         const AutomatonDecl& decl = *it.automaton;
@@ -818,7 +815,7 @@ private:
         for (const ConstraintDecl& c : b.constraints) {
             BcifsSystem::Constraint k;
             k.loc = c.loc;
-            k.text = factors_text(c.left) + " == " + factors_text(c.right);
+            k.text = print_product(c.left) + " == " + print_product(c.right);
             for (int s = 0; s < 2; ++s)
                 for (const FactorDecl& f : s == 0 ? c.left : c.right) {
                     BcifsSystem::Factor x;

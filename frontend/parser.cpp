@@ -207,14 +207,7 @@ private:
         if (a.bcifs && bcifs_stmt(a)) return;
         if (a.graph_directed && !a.bcifs && at_word("state")) {
             take();
-            std::vector<std::pair<std::string, Location>> names;
-            do {
-                const Token& n = expect(Tok::ident, "as a state name");
-                names.emplace_back(n.text, n.loc);
-            } while (accept(Tok::comma));
-            expect(Tok::kw_in, "and the states' space (R2, R3 or bary(n))");
-            const SpaceDecl s = space();
-            for (auto& [n, loc] : names) a.states.push_back({n, loc, s, nullptr});
+            state_list(a, "as a state name", "and the states' space (R2, R3 or bary(n))", 2);
         } else if (a.graph_directed && at_word("initial")) {
             take();
             const Token& n = expect(Tok::ident, "(the initial state) after 'initial'");
@@ -275,20 +268,25 @@ private:
         expect(Tok::semicolon, "after the statement");
     }
 
+    // NAME, NAME ... in SPACE: states (cells) of one space.
+    void state_list(AutomatonDecl& a, const char* name_what, const char* space_what, int min_weights) {
+        std::vector<std::pair<std::string, Location>> names;
+        do {
+            const Token& n = expect(Tok::ident, name_what);
+            names.emplace_back(n.text, n.loc);
+        } while (accept(Tok::comma));
+        expect(Tok::kw_in, space_what);
+        const SpaceDecl s = space(min_weights);
+        for (auto& [n, loc] : names) a.states.push_back({n, loc, s, nullptr});
+    }
+
     // The statements only a bcifs has; false when the statement is a common one (initial, primitive,
     // project) or a constraint. Block statements take their own closing brace (and an optional ';').
     bool bcifs_stmt(AutomatonDecl& a) {
         BcifsDecl& b = *a.bcifs;
         if (at_word("cell")) {
             take();
-            std::vector<std::pair<std::string, Location>> names;
-            do {
-                const Token& n = expect(Tok::ident, "as a cell name");
-                names.emplace_back(n.text, n.loc);
-            } while (accept(Tok::comma));
-            expect(Tok::kw_in, "and the cells' space (bary(n), R2 or R3)");
-            const SpaceDecl s = space(1);
-            for (auto& [n, loc] : names) a.states.push_back({n, loc, s, nullptr});
+            state_list(a, "as a cell name", "and the cells' space (bary(n), R2 or R3)", 1);
         } else if (at_word("param")) {
             take();
             ParamDecl p;
@@ -346,6 +344,36 @@ private:
             expect(Tok::rbrace, "to close the operators");
             accept(Tok::semicolon);
             return true;
+        } else if (at_word("topology")) {
+            take();
+            TopologyDecl t;
+            const Token& cell = expect(Tok::ident, "(a cell) after 'topology'");
+            t.cell = cell.text;
+            t.loc = cell.loc;
+            expect(Tok::assign, "after the cell (topology f = quad(e) split 2 x 2)");
+            const Token& kind = expect(Tok::ident, "(edge or quad)");
+            t.kind = kind.text;
+            t.kind_loc = kind.loc;
+            if (t.kind != "edge" && t.kind != "quad")
+                throw CompileError(kind.loc,
+                                   fmt::format("no topology '{}': the topologies are edge(v) split n "
+                                               "and quad(e) split n x n",
+                                               t.kind));
+            expect(Tok::lparen, "after the topology");
+            const Token& of = expect(Tok::ident, t.kind == "edge" ? "(the vertex cell)" : "(the edge cell)");
+            t.of = of.text;
+            t.of_loc = of.loc;
+            expect(Tok::rparen, "after the boundary cell");
+            if (!at_word("split")) fail("expected 'split' and the number of parts");
+            take();
+            t.n = count();
+            if (t.kind == "quad") {
+                if (!at_word("x") && !at(Tok::times) && !at(Tok::star))
+                    fail("expected 'x' and the parts along t");
+                take();
+                t.m = count();
+            }
+            b.topologies.push_back(std::move(t));
         } else if (at_word("fix")) {
             take();
             FixDecl f;
@@ -364,6 +392,16 @@ private:
         }
         expect(Tok::semicolon, "after the statement");
         return true;
+    }
+
+    // The number of parts of a topology: 1 to 16.
+    int count() {
+        const Token& n = expect(Tok::number, "(the number of parts)");
+        const int v = std::atoi(n.text.c_str());
+        if (n.text.find_first_not_of("0123456789") != std::string::npos || n.text.size() > 2 || v < 1 ||
+            v > 16)
+            throw CompileError(n.loc, fmt::format("a topology splits into 1 to 16 parts, not {}", n.text));
+        return v;
     }
 
     // [k]: an entry index, counted from 0.
@@ -673,8 +711,8 @@ private:
         case Tok::question: {
             if (!unknown_entries_)
                 fail("'?' (an unknown entry) is written only in a bcifs operator's matrix");
-            auto e = make(ExprKind::name, take().loc);
-            e->text = "?";
+            auto e = make(ExprKind::name, tok.loc);
+            e->text = take().text; // "?"
             return e;
         }
         case Tok::kw_fn:

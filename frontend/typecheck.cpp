@@ -380,6 +380,18 @@ private:
             return TValue::of(Type::number());
         }
         if (b.kind == BuiltinKind::controls) return TValue::of(controls_type(e));
+        if (b.kind == BuiltinKind::kron) {
+            Type t[2];
+            for (int k = 0; k < 2; ++k) {
+                t[k] = expr(*e.args[k].value).type;
+                if (t[k].kind != Type::Kind::matrix)
+                    fail(e.args[k].loc,
+                         fmt::format("'kron' multiplies two matrices, found {}", type_name(t[k])));
+            }
+            if (t[0].rows * t[1].rows > 4096 || t[0].cols * t[1].cols > 4096)
+                fail(e.loc, "'kron' would make a matrix of more than 4096 rows or columns");
+            return TValue::of(Type::matrix(t[0].rows * t[1].rows, t[0].cols * t[1].cols));
+        }
         if (b.kind == BuiltinKind::primitive)
             fail(e.loc,
                  fmt::format("'{}' draws a state of an automaton: it is written after 'primitive' only",
