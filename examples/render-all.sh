@@ -47,6 +47,10 @@ automaton cubic_bspline tree 6 svg
 automaton barnsley_fern chaos "" png
 automaton fern_of_triangles chaos "" png
 automaton penrose chaos "" png
+# Boundary controlled IFS (examples/bcifs.frac): constraints solved by the compiler, drawn by the chaos game.
+for name in fractal_edge spiky_edge c1_edge quad_patch; do
+    "$frac" render "$here/bcifs.frac" "$name" --method chaos --size 512 -o "$out/bcifs_$name.png"
+done
 echo
 echo "pictures (left: recursive subdivision process, right: cover) and meshes are in $out:"
 ls -1 "$out" | sed "s|^|  $out/|"
