@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <stdexcept>
 #include <type_traits>
@@ -59,7 +60,28 @@ std::string corner_text(const CellLayout& l, Index cs, Index ct) {
 template <typename T>
 class Geometry {
 public:
-    Geometry(const ir::Automaton& a, const SurfaceLayout& l) : a_(a), l_(l), corners_(a.states.size()) {}
+    Geometry(const ir::Automaton& a, const SurfaceLayout& l) : a_(a), l_(l), corners_(a.states.size()) {
+        if constexpr (std::is_same_v<T, double>)
+            for (std::size_t q = 0; q < l.corners.size() && q < corners_.size(); ++q)
+                for (std::size_t c = 0; c < 4; ++c)
+                    if (!l.corners[q][c].empty()) corners_[q][c] = Matrix<double>::column(l.corners[q][c]);
+    }
+
+    // The corners computed so far, rounded.
+    std::vector<std::array<std::vector<double>, 4>> corners() const {
+        std::vector<std::array<std::vector<double>, 4>> out(corners_.size());
+        for (std::size_t q = 0; q < corners_.size(); ++q)
+            for (std::size_t c = 0; c < 4; ++c)
+                if (const auto& p = corners_[q][c]) {
+                    for (std::size_t r = 0; r < p->rows(); ++r) {
+                        if constexpr (std::is_same_v<T, Rational>)
+                            out[q][c].push_back((*p)(r, 0).to_double());
+                        else
+                            out[q][c].push_back((*p)(r, 0));
+                    }
+                }
+        return out;
+    }
 
     const Matrix<T>& op(std::size_t arc) const {
         if constexpr (std::is_same_v<T, Rational>)
@@ -111,13 +133,15 @@ public:
     }
 
     // The point at (x, y) of state q's grid of resolution n^m, through the lower cell on shared sides.
-    Matrix<T> point(std::size_t q, int m, Index x, Index y) {
+    const Matrix<T>& point(std::size_t q, int m, Index x, Index y) {
         const CellLayout& l = *l_.states[q];
         if (m == 0) return corner(q, x, y);
+        const std::array<Index, 4> key{Index(q), m, x, y};
+        if (const auto it = points_.find(key); it != points_.end()) return it->second;
         const Index cs = power(l.n_s, m - 1), ct = extent_t(l, m - 1);
         const std::size_t k = cell_of(l, x, y, cs, ct);
-        return point_via(q, k, m - 1, x - static_cast<Index>(k / l.n_t) * cs,
-                         y - static_cast<Index>(k % l.n_t) * ct);
+        return points_[key] = point_via(q, k, m - 1, x - static_cast<Index>(k / l.n_t) * cs,
+                                        y - static_cast<Index>(k % l.n_t) * ct);
     }
 
     // The point at (x, y) of cell k's own grid of resolution n^m, mapped by the cell's operator.
@@ -132,6 +156,7 @@ private:
     const ir::Automaton& a_;
     const SurfaceLayout& l_;
     std::vector<std::array<std::optional<Matrix<T>>, 4>> corners_;
+    std::map<std::array<Index, 4>, Matrix<T>> points_; // point(q, m, x, y) for m > 0
 };
 
 bool same_point(const Matrix<Rational>& p, const Matrix<Rational>& q) {
@@ -155,8 +180,8 @@ std::string cell_text(const ir::Automaton& a, const CellLayout& l, std::size_t k
 
 // Adjacent sub-cells agree at the points of depth check_depth along their common side.
 template <typename T>
-void check_joins(const ir::Automaton& a, const SurfaceLayout& layout,
-                 const std::vector<std::size_t>& states) {
+void check_joins(const ir::Automaton& a, SurfaceLayout& layout, const std::vector<std::size_t>& states) {
+    layout.corners.clear();
     Geometry<T> g(a, layout);
     for (const std::size_t q : states) {
         const CellLayout& l = *layout.states[q];
@@ -183,6 +208,7 @@ void check_joins(const ir::Automaton& a, const SurfaceLayout& layout,
         for (Index cs = 0; cs < 2; ++cs)
             for (Index ct = 0; ct <= extent_t(l, 0); ++ct) g.corner(q, cs, ct);
     }
+    layout.corners = g.corners();
 }
 
 // The states the layout reaches from the root, checking each one's shape.
@@ -383,29 +409,21 @@ Tessellation tessellate(const ir::Automaton& a, const SurfaceLayout& layout, int
     t.vertices.resize(t.side_s * t.side_t);
     std::vector<std::uint8_t> written(t.vertices.size(), 0);
 
-    // Each state's grid of depth m in its own coordinates (exact, then rounded, for exact operators):
-    // the walk composes down to depth p - m and maps these points.
+    // Each state's grid of depth m in its own coordinates (from its corners, exact then rounded when
+    // the operators are exact): the walk composes down to depth p - m and maps these points.
     const int m = std::min(depth, root.dimension == 2 ? 3 : 6);
     const Index gs = power(root.n_s, m), gt = extent_t(root, m);
     std::vector<std::vector<double>> grid(a.states.size()); // point g's n_q coordinates at g * n_q
-    {
-        Geometry<Rational> exact(a, layout);
-        Geometry<double> nearest(a, layout);
-        for (const std::size_t q : states) {
-            const auto n = static_cast<std::size_t>(a.states[q].space.coordinates());
-            grid[q].resize(static_cast<std::size_t>((gs + 1) * (gt + 1)) * n);
-            for (Index x = 0; x <= gs; ++x)
-                for (Index y = 0; y <= gt; ++y) {
-                    double* out = &grid[q][static_cast<std::size_t>(x * (gt + 1) + y) * n];
-                    if (layout.exact) {
-                        const Matrix<Rational> p = exact.point(q, m, x, y);
-                        for (std::size_t r = 0; r < n; ++r) out[r] = p(r, 0).to_double();
-                    } else {
-                        const Matrix<double> p = nearest.point(q, m, x, y);
-                        for (std::size_t r = 0; r < n; ++r) out[r] = p(r, 0);
-                    }
-                }
-        }
+    Geometry<double> geometry(a, layout);
+    for (const std::size_t q : states) {
+        const auto n = static_cast<std::size_t>(a.states[q].space.coordinates());
+        grid[q].resize(static_cast<std::size_t>((gs + 1) * (gt + 1)) * n);
+        for (Index x = 0; x <= gs; ++x)
+            for (Index y = 0; y <= gt; ++y) {
+                const Matrix<double>& p = geometry.point(q, m, x, y);
+                for (std::size_t r = 0; r < n; ++r)
+                    grid[q][static_cast<std::size_t>(x * (gt + 1) + y) * n + r] = p(r, 0);
+            }
     }
 
     // Composites P T_1 ... T_d (output rows only, 3 x n_q, row-major), one buffer per level.

@@ -45,6 +45,9 @@ struct SurfaceLayout {
     std::vector<std::optional<CellLayout>> states;
     bool exact = false; // the joins were verified in exact rationals (else to 1e-9 relative)
     std::string how;    // how the layout was found, for messages
+    // Set by check_layout: per state, the homogeneous columns of its corners (s, t) at index s + 2 t
+    // (exact, then rounded, for exact operators), which tessellate reuses.
+    std::vector<std::array<std::vector<double>, 4>> corners;
 };
 
 // What the command line says about the layout; zeros and empty mean "infer".
