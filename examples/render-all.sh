@@ -47,6 +47,10 @@ automaton cubic_bspline tree 6 svg
 automaton barnsley_fern chaos "" png
 automaton fern_of_triangles chaos "" png
 automaton penrose chaos "" png
+# Projected-IFS surfaces and curves (stdlib/ifs.frac): quad patches tessellated, a curve as a polyline.
+"$frac" mesh "$here/automata.frac" bicubic_bspline_patch --depth 7 -o "$out/bicubic_bspline_patch.stl"
+"$frac" mesh "$here/automata.frac" biquadratic_bezier_patch --depth 6 -o "$out/biquadratic_bezier_patch.obj"
+"$frac" mesh "$here/automata.frac" cubic_bspline --depth 7 -o "$out/cubic_bspline_curve.svg"
 echo
 echo "pictures (left: recursive subdivision process, right: cover) and meshes are in $out:"
 ls -1 "$out" | sed "s|^|  $out/|"

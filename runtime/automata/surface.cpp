@@ -12,7 +12,6 @@
 #include <fstream>
 #include <limits>
 #include <map>
-#include <numeric>
 #include <stdexcept>
 #include <type_traits>
 
