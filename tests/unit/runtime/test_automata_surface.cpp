@@ -62,6 +62,18 @@ ir::Automaton mirrored_square() {
     return a;
 }
 
+// The unit square's grid: vertex (i, j) exactly at (i / n, j / n, 0) (dyadic: no rounding anywhere).
+void check_unit_grid(const rt::Tessellation& t, std::size_t n) {
+    REQUIRE(t.vertices.size() == (n + 1) * (n + 1));
+    for (std::size_t i = 0; i <= n; ++i)
+        for (std::size_t j = 0; j <= n; ++j) {
+            const auto& v = t.vertices[i * (n + 1) + j];
+            CHECK(v[0] == static_cast<double>(i) / static_cast<double>(n));
+            CHECK(v[1] == static_cast<double>(j) / static_cast<double>(n));
+            CHECK(v[2] == 0);
+        }
+}
+
 } // namespace
 
 TEST_CASE("the bicubic patch's vertices are the tensor-product B-spline", "[automata][surface]") {
@@ -176,17 +188,32 @@ TEST_CASE("a mirrored sub-cell: an explicit layout places it", "[automata][surfa
     layout.states[0] = rt::CellLayout{2, 2, 2, {{0}, {1}, {2, false, true, false}, {3}}};
     rt::check_layout(a, layout);
     CHECK(layout.exact);
-    const rt::Tessellation t = rt::tessellate(a, layout, 5);
-    REQUIRE(t.vertices.size() == 33 * 33);
-    for (std::size_t i = 0; i <= 32; ++i)
-        for (std::size_t j = 0; j <= 32; ++j) {
-            CHECK(t.vertices[i * 33 + j][0] == static_cast<double>(i) / 32);
-            CHECK(t.vertices[i * 33 + j][1] == static_cast<double>(j) / 32);
-            CHECK(t.vertices[i * 33 + j][2] == 0);
-        }
+    check_unit_grid(rt::tessellate(a, layout, 5), 32);
     // Without the flip, the quarters do not meet.
     layout.states[0]->cells[2].flip_s = false;
     CHECK_THROWS_WITH(rt::check_layout(a, layout), Catch::Contains("(0, 0) [A] and (1, 0) [C]"));
+}
+
+TEST_CASE("a transposed and reversed sub-cell: swap and flips compose", "[automata][surface]") {
+    // Quarter (1, 1) maps (u, v) to (1 - v/2, 1/2 + u/2): swapped, then reversed in s.
+    ir::Automaton a = mirrored_square();
+    const Rational h = q(1, 2);
+    a.arcs[3] = arc(0, 0, affine({{0, -h}, {h, 0}}, {1, h}), "D");
+    rt::SurfaceLayout layout;
+    layout.states.resize(1);
+    layout.states[0] = rt::CellLayout{2, 2, 2, {{0}, {1}, {2, false, true, false}, {3, true, true, false}}};
+    rt::check_layout(a, layout);
+    check_unit_grid(rt::tessellate(a, layout, 4), 16);
+    // Swapped without the flip, or flipped without the swap: the quarters do not meet (the first
+    // join found wrong is elsewhere, the corner (1, 1) of the square being D's).
+    layout.states[0]->cells[3].flip_s = false;
+    CHECK_THROWS_WITH(rt::check_layout(a, layout), Catch::Contains("do not meet"));
+    layout.states[0]->cells[3] = {3, false, true, false};
+    CHECK_THROWS_WITH(rt::check_layout(a, layout), Catch::Contains("do not meet"));
+    // A swap needs a square patch.
+    layout.states[0]->cells[3] = {3, true, true, false};
+    layout.states[0]->dimension = 1;
+    CHECK_THROWS(rt::check_layout(a, layout));
 }
 
 TEST_CASE("curves: a cubic B-spline of two segments as a polyline", "[automata][surface]") {
