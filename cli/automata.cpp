@@ -96,6 +96,23 @@ rt::LayoutRequest layout_request(const MeshOptions& o) {
     return r;
 }
 
+// Several patches joined along the sides they share (rt::tessellate_patches).
+int mesh_patches(const front::AutomatonInfo& info, const MeshOptions& o) {
+    const rt::PatchSurface s = runtime_job([&] { return rt::tessellate_patches(info.automaton, o.depth); });
+    if (ends_with(o.output, ".svg"))
+        throw UsageError(fmt::format("{} is a surface: write it as .stl, .obj or .ply", info.name));
+    const rt::MeshCheck check = rt::check_mesh(s.mesh);
+    const bool ok = check.manifold && check.oriented && check.edges > 0;
+    std::cerr << fmt::format(
+        "{}: {} patches, {} joined sides; depth {}: {} vertices, {} triangles, {} rim edges; "
+        "{}, Euler characteristic {}, {} components\n",
+        info.name, s.patches, s.joins, o.depth, s.mesh.vertices.size(), s.mesh.triangles.size(),
+        check.boundary_edges, ok ? "manifold and oriented" : "NOT manifold: " + check.problem, check.euler,
+        check.components);
+    write_mesh_file(s.mesh, o.output, o.force);
+    return ok ? 0 : 1;
+}
+
 } // namespace
 
 const front::AutomatonInfo& find_automaton(const front::Compilation& c, const std::string& name) {
@@ -211,7 +228,20 @@ int mesh_automaton(const front::AutomatonInfo& info, const MeshOptions& o) {
     if (o.depth > 24) throw UsageError("--depth of a tessellation is at most 24");
     const ir::Automaton& a = info.automaton;
     const rt::LayoutRequest request = layout_request(o);
-    const rt::SurfaceLayout layout = runtime_job([&] { return rt::infer_layout(a, request); });
+    // An initial state that is never reached again and is no grid itself: a set of patches.
+    bool set_of_patches = request.n_s == 0 && request.cells.empty();
+    for (const ir::Arc& arc : a.arcs) set_of_patches = set_of_patches && arc.to != a.initial;
+    rt::SurfaceLayout layout;
+    try {
+        layout = rt::infer_layout(a, request);
+    } catch (const std::invalid_argument& e) {
+        if (!set_of_patches) throw RunError(e.what());
+        try {
+            return mesh_patches(info, o);
+        } catch (const RunError& patches) {
+            throw RunError(fmt::format("{}; nor is it a set of patches: {}", e.what(), patches.what()));
+        }
+    }
     const rt::Tessellation t = runtime_job([&] { return rt::tessellate(a, layout, o.depth); });
     std::cerr << fmt::format("{}: {}; depth {}: {} vertices\n", info.name, layout.how, o.depth,
                              t.vertices.size());

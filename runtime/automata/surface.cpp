@@ -12,6 +12,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <stdexcept>
 #include <type_traits>
 
@@ -512,6 +513,105 @@ Mesh surface_mesh(const Tessellation& t) {
             mesh.triangles.push_back({v00, v11, v01});
         }
     return mesh;
+}
+
+PatchSurface tessellate_patches(const ir::Automaton& a, int depth) {
+    require_well_formed(a);
+    const std::vector<std::size_t> arcs = a.arcs_from(a.initial);
+    for (const ir::Arc& arc : a.arcs)
+        if (arc.to == a.initial)
+            throw std::invalid_argument(
+                fmt::format("{}: the initial state {} is reached again, so its arcs are no set of patches",
+                            a.name, a.states[a.initial].name));
+    const ir::Operator out = a.projection
+                                 ? *a.projection
+                                 : ir::Operator::from_exact(num::Matrix<Rational>::identity(
+                                       static_cast<std::size_t>(a.states[a.initial].space.coordinates())));
+    PatchSurface result;
+    std::vector<Tessellation> patches;
+    for (const std::size_t i : arcs) {
+        // The patch alone: its state first, drawn through the projection and the arc's operator.
+        ir::Automaton patch = a;
+        patch.name = fmt::format("{} {}", a.name, ir::arc_name(a, i));
+        patch.initial = a.arcs[i].to;
+        const ir::Operator& op = a.arcs[i].op;
+        patch.projection = out.exact && op.exact ? ir::Operator::from_exact(*out.exact * *op.exact)
+                                                 : ir::Operator::from_enclosure(out.enclosure * op.enclosure);
+        const SurfaceLayout layout = infer_layout(patch);
+        if (layout.states[patch.initial]->dimension != 2)
+            throw std::invalid_argument(
+                fmt::format("{}: arc {} leads to a curve, not a patch", a.name, ir::arc_name(a, i)));
+        patches.push_back(tessellate(patch, layout, depth));
+    }
+    result.patches = patches.size();
+
+    // All vertices in patch order; sides as lists of global indices.
+    std::vector<std::size_t> first(patches.size() + 1, 0);
+    for (std::size_t k = 0; k < patches.size(); ++k) first[k + 1] = first[k] + patches[k].vertices.size();
+    std::vector<std::array<double, 3>> all;
+    all.reserve(first.back());
+    for (const Tessellation& t : patches) all.insert(all.end(), t.vertices.begin(), t.vertices.end());
+    double extent = 0;
+    for (const auto& v : all)
+        for (const double c : v) extent = std::max(extent, std::abs(c));
+    const double tolerance = 1e-9 * (1 + extent);
+    const auto near = [&](std::size_t u, std::size_t v) {
+        for (std::size_t r = 0; r < 3; ++r)
+            if (std::abs(all[u][r] - all[v][r]) > tolerance) return false;
+        return true;
+    };
+    std::vector<std::vector<std::size_t>> sides;
+    for (std::size_t k = 0; k < patches.size(); ++k) {
+        const Tessellation& t = patches[k];
+        for (int side = 0; side < 4; ++side) {
+            std::vector<std::size_t> list;
+            const std::size_t count = side < 2 ? t.side_t : t.side_s;
+            for (std::size_t c = 0; c < count; ++c) {
+                const std::size_t i = side == 0 ? 0 : side == 1 ? t.side_s - 1 : c;
+                const std::size_t j = side < 2 ? c : side == 2 ? 0 : t.side_t - 1;
+                list.push_back(first[k] + i * t.side_t + j);
+            }
+            sides.push_back(std::move(list));
+        }
+    }
+    // Joins: equal sides, in the same or the reverse order; each vertex then takes the lowest index.
+    std::vector<std::size_t> same(all.size());
+    std::iota(same.begin(), same.end(), std::size_t{0});
+    const auto find = [&](std::size_t v) {
+        while (same[v] != v) v = same[v] = same[same[v]];
+        return v;
+    };
+    for (std::size_t x = 0; x < sides.size(); ++x)
+        for (std::size_t y = x + 1; y < sides.size(); ++y) {
+            const auto& p = sides[x];
+            const auto& q = sides[y];
+            if (x / 4 == y / 4 || p.size() != q.size()) continue;
+            for (const bool reversed : {false, true}) {
+                bool equal = true;
+                for (std::size_t c = 0; c < p.size() && equal; ++c)
+                    equal = near(p[c], q[reversed ? q.size() - 1 - c : c]);
+                if (!equal) continue;
+                ++result.joins;
+                for (std::size_t c = 0; c < p.size(); ++c) {
+                    const std::size_t u = find(p[c]), v = find(q[reversed ? q.size() - 1 - c : c]);
+                    same[std::max(u, v)] = std::min(u, v);
+                }
+                break;
+            }
+        }
+    std::vector<std::uint32_t> index(all.size());
+    for (std::size_t v = 0; v < all.size(); ++v)
+        if (find(v) == v) {
+            index[v] = static_cast<std::uint32_t>(result.mesh.vertices.size());
+            result.mesh.vertices.push_back(all[v]);
+        }
+    for (std::size_t k = 0; k < patches.size(); ++k)
+        for (const auto& tri : surface_mesh(patches[k]).triangles) {
+            std::array<std::uint32_t, 3> joined{};
+            for (std::size_t c = 0; c < 3; ++c) joined[c] = index[find(first[k] + tri[c])];
+            result.mesh.triangles.push_back(joined);
+        }
+    return result;
 }
 
 void write_polyline_svg(const Tessellation& t, const std::string& path) {

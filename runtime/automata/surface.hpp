@@ -85,6 +85,18 @@ Tessellation tessellate(const ir::Automaton& a, const SurfaceLayout& layout, int
 // Two triangles per grid square, counter-clockwise around ds x dt. Throws for a curve.
 Mesh surface_mesh(const Tessellation& t);
 
+// A surface of several patches: each arc of the initial state leads to a patch state (laid out by
+// infer_layout from there), drawn through the arc's operator (and the projection). Each patch is
+// tessellated to depth p; a side of one patch whose vertices all coincide with a side of another (in
+// either order, within 1e-9 of the model's extent) is a join, and the two sides become one set of
+// vertices (the first patch's), so a closed model gives a closed mesh. Throws std::invalid_argument
+// when the initial state is reached again, a patch's layout cannot be inferred, or an arc leads to a curve.
+struct PatchSurface {
+    Mesh mesh;
+    std::size_t patches = 0, joins = 0; // joined side pairs
+};
+PatchSurface tessellate_patches(const ir::Automaton& a, int depth);
+
 // A curve: the vertices joined in order, as an SVG polyline (x, y seen from above) or an OBJ line
 // element. Throw std::runtime_error naming the path when the file cannot be written.
 void write_polyline_svg(const Tessellation& t, const std::string& path);

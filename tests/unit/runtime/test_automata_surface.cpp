@@ -74,7 +74,69 @@ void check_unit_grid(const rt::Tessellation& t, std::size_t n) {
         }
 }
 
+// The unit cube's surface as 6 bilinear patches (bary(4), T_st = L_s (x) L_t) drawn through the
+// controls of each face, (a, b) -> origin + a e1 + b e2 with e1 x e2 pointing out.
+ir::Automaton cube(std::size_t faces = 6) {
+    ir::Automaton a;
+    a.name = "cube";
+    a.states.push_back(state("box", ir::Space::euclidean(3)));
+    a.states.push_back(state("face", ir::Space::barycentric(4)));
+    using V = std::array<long, 3>;
+    const std::array<std::array<V, 3>, 6> frames{{{V{0, 0, 0}, V{0, 1, 0}, V{1, 0, 0}},
+                                                  {V{0, 0, 1}, V{1, 0, 0}, V{0, 1, 0}},
+                                                  {V{0, 0, 0}, V{1, 0, 0}, V{0, 0, 1}},
+                                                  {V{0, 1, 0}, V{0, 0, 1}, V{1, 0, 0}},
+                                                  {V{0, 0, 0}, V{0, 0, 1}, V{0, 1, 0}},
+                                                  {V{1, 0, 0}, V{0, 1, 0}, V{0, 0, 1}}}};
+    for (std::size_t f = 0; f < faces; ++f) {
+        Matrix<Rational> m(4, 4);
+        for (std::size_t c = 0; c < 4; ++c) {
+            const long u = static_cast<long>(c / 2), v = static_cast<long>(c % 2);
+            for (std::size_t r = 0; r < 3; ++r)
+                m(r, c) = frames[f][0][r] + u * frames[f][1][r] + v * frames[f][2][r];
+            m(3, c) = 1;
+        }
+        a.arcs.push_back(arc(0, 1, m, "F" + std::to_string(f)));
+    }
+    const Matrix<Rational> l[2] = {Matrix<Rational>{{1, q(1, 2)}, {0, q(1, 2)}},
+                                   Matrix<Rational>{{q(1, 2), 0}, {q(1, 2), 1}}};
+    for (int s = 0; s < 2; ++s)
+        for (int t = 0; t < 2; ++t) {
+            Matrix<Rational> m(4, 4);
+            for (std::size_t r = 0; r < 4; ++r)
+                for (std::size_t c = 0; c < 4; ++c) m(r, c) = l[s](r / 2, c / 2) * l[t](r % 2, c % 2);
+            a.arcs.push_back(arc(1, 1, m, "T" + std::to_string(s) + std::to_string(t)));
+        }
+    return a;
+}
+
 } // namespace
+
+TEST_CASE("several patches joined along their sides: a closed cube", "[automata][surface]") {
+    for (const int p : {0, 1, 3}) {
+        const std::size_t n = std::size_t{1} << p;
+        const rt::PatchSurface s = rt::tessellate_patches(cube(), p);
+        CHECK(s.patches == 6);
+        CHECK(s.joins == 12);
+        // 6 (n + 1)^2 grid vertices, the 12 edges' n + 1 shared once, the 8 corners three times.
+        CHECK(s.mesh.vertices.size() == 6 * (n + 1) * (n + 1) - 12 * (n + 1) + 8);
+        const rt::MeshCheck ck = rt::check_mesh(s.mesh);
+        INFO("depth " << p << ": " << ck.problem);
+        CHECK(ck.ok());
+        CHECK(ck.watertight);
+        CHECK(ck.euler == 2);
+        CHECK(ck.volume == Approx(1.0).epsilon(1e-12));
+    }
+    // Five faces: an open box, its rim the missing face's 4 n edges.
+    const rt::PatchSurface open = rt::tessellate_patches(cube(5), 2);
+    CHECK(open.joins == 8);
+    const rt::MeshCheck ck = rt::check_mesh(open.mesh);
+    CHECK_FALSE(ck.watertight);
+    CHECK(ck.boundary_edges == 16);
+    CHECK(ck.euler == 1);
+    // The initial state must not be reached again.
+    CHECK_THROWS_WITH(rt::tessellate_patches(projected_patch(2), 1), Catch::Contains("reached again"));
+}
 
 TEST_CASE("the bicubic patch's vertices are the tensor-product B-spline", "[automata][surface]") {
     const ir::Automaton a = projected_patch(3);
