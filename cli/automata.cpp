@@ -1,4 +1,4 @@
-// frac tree, frac chaos, and render / dimension of automata (ifs, cifs).
+// frac tree, frac chaos, and render / mesh / dimension of automata (ifs, cifs).
 #include "cli/commands.hpp"
 
 #include "driver/queries.hpp"
@@ -6,14 +6,19 @@
 #include "runtime/automata/attractor_cover.hpp"
 #include "runtime/automata/chaos.hpp"
 #include "runtime/automata/dimension.hpp"
+#include "runtime/automata/surface.hpp"
 #include "runtime/automata/tree.hpp"
 #include "runtime/dimension.hpp"
 #include "runtime/legend.hpp"
 #include "runtime/picture.hpp"
 
 #include <fmt/format.h>
+
+#include <algorithm>
+#include <charconv>
 #include <iostream>
 #include <stdexcept>
+#include <string_view>
 
 namespace frac::cli {
 
@@ -62,6 +67,50 @@ void write_cover(const rt::AttractorCoverResult& cover, const RenderOptions& o, 
         std::cout << fmt::format("level {:2}: {} cells, {} arcs, {} kept, area {:.6g}\n", s.level, s.cells,
                                  s.arcs, s.kept, s.area);
     std::cout << fmt::format("wrote {} (cell-graph cover of {})\n", o.output, name);
+}
+
+// --layout NxM or N, --cells A,B,...
+rt::LayoutRequest layout_request(const MeshOptions& o) {
+    rt::LayoutRequest r;
+    if (!o.layout.empty()) {
+        // N or NxM, digits only.
+        const auto number = [](std::string_view text) -> std::size_t {
+            std::size_t v = 0;
+            const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+            return ec == std::errc() && end == text.data() + text.size() && v >= 2 && v <= 64 ? v : 0;
+        };
+        const std::string_view text = o.layout;
+        const std::size_t x = text.find('x');
+        r.dimension = x == std::string_view::npos ? 1 : 2;
+        r.n_s = number(text.substr(0, x));
+        r.n_t = x == std::string_view::npos ? 1 : number(text.substr(x + 1));
+        if (r.n_s == 0 || r.n_t == 0)
+            throw UsageError(fmt::format(
+                "--layout needs NxM (a quad patch) or N (a curve), each 2 to 64, not '{}'", o.layout));
+    }
+    for (std::size_t start = 0; !o.cells.empty() && start <= o.cells.size();) {
+        const std::size_t comma = std::min(o.cells.find(',', start), o.cells.size());
+        r.cells.push_back(o.cells.substr(start, comma - start));
+        start = comma + 1;
+    }
+    return r;
+}
+
+// Several patches joined along the sides they share (rt::tessellate_patches).
+int mesh_patches(const front::AutomatonInfo& info, const MeshOptions& o) {
+    const rt::PatchSurface s = runtime_job([&] { return rt::tessellate_patches(info.automaton, o.depth); });
+    if (ends_with(o.output, ".svg"))
+        throw UsageError(fmt::format("{} is a surface: write it as .stl, .obj or .ply", info.name));
+    const rt::MeshCheck check = rt::check_mesh(s.mesh);
+    const bool ok = check.manifold && check.oriented && check.edges > 0;
+    std::cerr << fmt::format(
+        "{}: {} patches, {} joined sides; depth {}: {} vertices, {} triangles, {} rim edges; "
+        "{}, Euler characteristic {}, {} components\n",
+        info.name, s.patches, s.joins, o.depth, s.mesh.vertices.size(), s.mesh.triangles.size(),
+        check.boundary_edges, ok ? "manifold and oriented" : "NOT manifold: " + check.problem, check.euler,
+        check.components);
+    write_mesh_file(s.mesh, o.output, o.force);
+    return ok ? 0 : 1;
 }
 
 } // namespace
@@ -191,6 +240,55 @@ int render_map(front::Compilation& c, const front::Item& map, const RenderOption
     co.initial_level = o.depth - co.refinements;
     write_cover(runtime_job([&] { return rt::map_attractor_cover(parts, box, co); }), o, map.name);
     return 0;
+}
+
+int mesh_automaton(const front::AutomatonInfo& info, const MeshOptions& o) {
+    if (o.depth > 24) throw UsageError("--depth of a tessellation is at most 24");
+    const ir::Automaton& a = info.automaton;
+    const rt::LayoutRequest request = layout_request(o);
+    // An initial state that is never reached again and is no grid itself: a set of patches.
+    bool set_of_patches = request.n_s == 0 && request.cells.empty();
+    for (const ir::Arc& arc : a.arcs) set_of_patches = set_of_patches && arc.to != a.initial;
+    rt::SurfaceLayout layout;
+    try {
+        layout = rt::infer_layout(a, request);
+    } catch (const std::invalid_argument& e) {
+        if (!set_of_patches) throw RunError(e.what());
+        try {
+            return mesh_patches(info, o);
+        } catch (const RunError& patches) {
+            throw RunError(fmt::format("{}; nor is it a set of patches: {}", e.what(), patches.what()));
+        }
+    }
+    const rt::Tessellation t = runtime_job([&] { return rt::tessellate(a, layout, o.depth); });
+    std::cerr << fmt::format("{}: {}; depth {}: {} vertices\n", info.name, layout.how, o.depth,
+                             t.vertices.size());
+    if (t.dimension == 1) {
+        if (!ends_with(o.output, ".svg") && !ends_with(o.output, ".obj"))
+            throw UsageError(
+                fmt::format("{} is a curve: write it as a polyline, -o FILE.svg or FILE.obj", info.name));
+        check_output_size(o.output, 40.0 * static_cast<double>(t.vertices.size()), o.force);
+        runtime_job([&] {
+            if (ends_with(o.output, ".svg"))
+                rt::write_polyline_svg(t, o.output);
+            else
+                rt::write_polyline_obj(t, o.output);
+            return 0;
+        });
+        std::cerr << fmt::format("wrote {}\n", o.output);
+        return 0;
+    }
+    if (ends_with(o.output, ".svg"))
+        throw UsageError(fmt::format("{} is a surface: write it as .stl, .obj or .ply", info.name));
+    const rt::Mesh mesh = rt::surface_mesh(t);
+    const rt::MeshCheck check = rt::check_mesh(mesh);
+    const bool ok = check.manifold && check.oriented && check.edges > 0;
+    std::cerr << fmt::format("{}: {} triangles, {} rim edges; {}, Euler characteristic {}, {} components\n",
+                             info.name, mesh.triangles.size(), check.boundary_edges,
+                             ok ? "manifold and oriented" : "NOT manifold: " + check.problem, check.euler,
+                             check.components);
+    write_mesh_file(mesh, o.output, o.force);
+    return ok ? 0 : 1;
 }
 
 int automaton_dimension(const front::AutomatonInfo& info, int from, int to) {

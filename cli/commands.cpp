@@ -159,7 +159,8 @@ double output_limit() {
     return output_size_limit;
 }
 
-// Refuses an output whose estimated size exceeds the limit unless forced.
+} // namespace
+
 void check_output_size(const std::string& path, double bytes, bool force) {
     const double limit = output_limit();
     if (bytes <= limit || force) return;
@@ -167,8 +168,6 @@ void check_output_size(const std::string& path, double bytes, bool force) {
                                "lower --depth, or pass --force to write it anyway",
                                path, bytes / 1e6, limit / 1e6));
 }
-
-} // namespace
 
 int run_render(const std::string& file, const RenderOptions& o, const EngineOptions& engine) {
     if (o.output.empty() && o.ascii.empty())
@@ -284,9 +283,10 @@ int run_dimension(const std::string& file, const std::string& shape, int from, i
 
 int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions& engine) {
     if (o.output.empty()) throw UsageError("mesh needs -o FILE.stl|FILE.obj|FILE.ply");
-    if (!ends_with(o.output, ".stl") && !ends_with(o.output, ".obj") && !ends_with(o.output, ".ply"))
-        throw UsageError(
-            fmt::format("cannot tell the mesh format of '{}': use .stl, .obj or .ply", o.output));
+    if (!ends_with(o.output, ".stl") && !ends_with(o.output, ".obj") && !ends_with(o.output, ".ply") &&
+        !ends_with(o.output, ".svg"))
+        throw UsageError(fmt::format(
+            "cannot tell the mesh format of '{}': use .stl, .obj or .ply (.svg for curves)", o.output));
     rt::MeshSelection selection = rt::MeshSelection::inside;
     if (o.select == "cover")
         selection = rt::MeshSelection::inside_and_boundary;
@@ -297,6 +297,9 @@ int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions&
     check_output_writable(o.output);
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
+    if (const front::AutomatonInfo* a = c->module.find_automaton(o.shape)) return mesh_automaton(*a, o);
+    if (ends_with(o.output, ".svg"))
+        throw UsageError("a shape is meshed as .stl, .obj or .ply; .svg is for the curves of automata");
     const front::ShapeInfo& s = pick_shape(*c, o.shape);
     if (s.dimension != 3)
         throw UsageError(fmt::format("shape '{}' is {}D; meshes are of 3D shapes (frac render draws 2D ones)",
@@ -328,18 +331,22 @@ int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions&
                              mesh.triangles.size(),
                              check.ok() ? "watertight and manifold" : "NOT printable: " + check.problem,
                              check.euler, check.components);
+    write_mesh_file(mesh, o.output, o.force);
+    return check.ok() ? 0 : 1;
+}
+
+void write_mesh_file(const rt::Mesh& mesh, const std::string& path, bool force) {
     // Binary STL takes 50 bytes a triangle; OBJ and PLY text about as much with the vertices.
-    check_output_size(o.output,
+    check_output_size(path,
                       50.0 * static_cast<double>(mesh.triangles.size()) +
                           40.0 * static_cast<double>(mesh.vertices.size()),
-                      o.force);
+                      force);
     try {
-        rt::write_mesh(mesh, o.output);
+        rt::write_mesh(mesh, path);
     } catch (const std::exception& e) {
         throw RunError(e.what());
     }
-    std::cerr << fmt::format("wrote {}\n", o.output);
-    return check.ok() ? 0 : 1;
+    std::cerr << fmt::format("wrote {}\n", path);
 }
 
 } // namespace frac::cli

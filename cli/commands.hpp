@@ -2,6 +2,7 @@
 #pragma once
 
 #include "cli/session.hpp"
+#include "runtime/mesh.hpp"
 
 #include <string>
 #include <vector>
@@ -21,10 +22,15 @@ int run_eval(const std::string& file, const std::string& shape, const std::strin
              const EngineOptions& engine);
 // Largest file `render` and `mesh` write without --force (an estimate, checked before writing).
 inline constexpr double output_size_limit = 100e6;
+// Refuses (RunError) an output whose estimated size exceeds the limit unless forced.
+void check_output_size(const std::string& path, double bytes, bool force);
+// Writes a mesh (format by extension) after the size check, and says so on stderr.
+void write_mesh_file(const rt::Mesh& mesh, const std::string& path, bool force);
 
 int run_render(const std::string& file, const RenderOptions& options, const EngineOptions& engine);
 struct MeshOptions {
     std::string shape, box, output, select = "inside";
+    std::string layout, cells; // automata: "NxM" or "N" (a curve), and the initial state's arcs in cell order
     int depth = 4, split = 2;
     bool force = false; // write a mesh over the size limit
 };
@@ -58,6 +64,9 @@ struct ChaosCommandOptions {
 // frac chaos FILE NAME -n POINTS -o FILE.png: the chaos game's density, seeded and reproducible.
 int run_chaos(const std::string& file, const ChaosCommandOptions& options);
 const front::AutomatonInfo& find_automaton(const front::Compilation& c, const std::string& name);
+// frac mesh of an ifs or cifs: its quad patch tessellated (.stl, .obj, .ply) or its curve as a polyline
+// (.svg, .obj).
+int mesh_automaton(const front::AutomatonInfo& a, const MeshOptions& options);
 // The similarity dimension with its proven bracket, or box counting of the chaos-game cover.
 int automaton_dimension(const front::AutomatonInfo& a, int from, int to);
 

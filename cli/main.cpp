@@ -131,7 +131,8 @@ int run(int argc, char** argv) {
 
     cli::MeshOptions mesh_options;
     auto* mesh =
-        app.add_subcommand("mesh", "cover a 3D shape by an octree and write a watertight mesh of it");
+        app.add_subcommand("mesh", "cover a 3D shape by an octree and write a watertight mesh of it, or "
+                                   "tessellate the patch or curve of an ifs or cifs");
     mesh->add_option("file", file, "model file")->required();
     mesh->add_option("shape", mesh_options.shape, "shape name (default: the last shape of the file)");
     mesh->add_option("--depth", mesh_options.depth, "subdivision depth")
@@ -146,7 +147,13 @@ int run(int argc, char** argv) {
                      "boundary cells (a thin solid around the surface)")
         ->check(CLI::IsMember({"inside", "cover", "boundary"}))
         ->capture_default_str();
-    mesh->add_option("-o,--output", mesh_options.output, "mesh file: .stl (binary), .obj or .ply");
+    mesh->add_option("--layout", mesh_options.layout,
+                     "automata: how the initial state is cut, NxM (a quad patch) or N (a curve); default: "
+                     "inferred from the operators");
+    mesh->add_option("--cells", mesh_options.cells,
+                     "automata: the initial state's arc labels in cell order (i * M + j), comma-separated");
+    mesh->add_option("-o,--output", mesh_options.output,
+                     "mesh file: .stl (binary), .obj or .ply; a curve of an automaton: .svg or .obj");
     mesh->add_flag("--force", mesh_options.force, "write a mesh estimated above 100 MB");
     add_engine(mesh);
 

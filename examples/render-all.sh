@@ -51,6 +51,10 @@ automaton penrose chaos "" png
 for name in fractal_edge spiky_edge c1_edge quad_patch; do
     "$frac" render "$here/bcifs.frac" "$name" --method chaos --size 512 -o "$out/bcifs_$name.png"
 done
+# Projected-IFS surfaces and curves (stdlib/ifs.frac): quad patches tessellated, a curve as a polyline.
+"$frac" mesh "$here/automata.frac" bicubic_bspline_patch --depth 7 -o "$out/bicubic_bspline_patch.stl"
+"$frac" mesh "$here/automata.frac" biquadratic_bezier_patch --depth 6 -o "$out/biquadratic_bezier_patch.obj"
+"$frac" mesh "$here/automata.frac" cubic_bspline --depth 7 -o "$out/cubic_bspline_curve.svg"
 echo
 echo "pictures (left: recursive subdivision process, right: cover) and meshes are in $out:"
 ls -1 "$out" | sed "s|^|  $out/|"

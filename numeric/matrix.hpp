@@ -117,7 +117,12 @@ Matrix<T> operator*(const Matrix<T>& a, const Matrix<T>& b) {
     for (std::size_t r = 0; r < a.rows(); ++r)
         for (std::size_t c = 0; c < b.cols(); ++c) {
             T sum{};
-            for (std::size_t k = 0; k < a.cols(); ++k) sum = sum + a(r, k) * b(k, c);
+            for (std::size_t k = 0; k < a.cols(); ++k) {
+                // Exact types skip zero terms (no allocation for them); doubles keep 0 * inf = NaN.
+                if constexpr (requires { a(r, k).is_zero(); })
+                    if (a(r, k).is_zero() || b(k, c).is_zero()) continue;
+                sum = sum + a(r, k) * b(k, c);
+            }
             p(r, c) = sum;
         }
     return p;

@@ -65,19 +65,20 @@ double selected_volume(const Cover& r, MeshSelection selection);
 double enclosed_volume(const Mesh& mesh);
 
 struct MeshCheck {
-    bool watertight = false;        // every edge has exactly two incident triangles
-    bool manifold = false;          // no edge with more than two triangles, and the triangles around each
-                                    // vertex form a single fan (a disc, or a half-disc on an open boundary)
-    bool oriented = false;          // every edge with two triangles is used once in each direction
-    double volume = 0;              // enclosed_volume: positive when the normals point outwards
-    std::uint64_t vertices = 0;     // vertices used by some triangle
-    std::uint64_t unreferenced = 0; // vertices used by none (not an error)
-    std::uint64_t edges = 0;        // distinct undirected edges
-    std::uint64_t faces = 0;        // triangles
-    std::int64_t euler = 0;         // vertices - edges + faces
-    std::uint64_t components = 0;   // connected components (through shared vertices)
-    std::uint64_t degenerate = 0;   // triangles with a repeated vertex or zero area
-    std::string problem;            // the first problem found, in words; empty when there is none
+    bool watertight = false;          // every edge has exactly two incident triangles
+    bool manifold = false;            // no edge with more than two triangles, and the triangles around each
+                                      // vertex form a single fan (a disc, or a half-disc on an open boundary)
+    bool oriented = false;            // every edge with two triangles is used once in each direction
+    double volume = 0;                // enclosed_volume: positive when the normals point outwards
+    std::uint64_t vertices = 0;       // vertices used by some triangle
+    std::uint64_t unreferenced = 0;   // vertices used by none (not an error)
+    std::uint64_t edges = 0;          // distinct undirected edges
+    std::uint64_t boundary_edges = 0; // edges with one triangle: the rim of an open surface
+    std::uint64_t faces = 0;          // triangles
+    std::int64_t euler = 0;           // vertices - edges + faces
+    std::uint64_t components = 0;     // connected components (through shared vertices)
+    std::uint64_t degenerate = 0;     // triangles with a repeated vertex or zero area
+    std::string problem;              // the first problem found, in words; empty when there is none
 
     // Closed, manifold, oriented outwards and without degenerate triangles: printable.
     bool ok() const {

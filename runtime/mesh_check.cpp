@@ -113,6 +113,7 @@ MeshCheck check_mesh(const Mesh& mesh) {
         if (a == b) continue; // degenerate, reported above
         ++ck.edges;
         if (uses < 2) {
+            ++ck.boundary_edges;
             closed = false;
             problem(fmt::format("edge ({}, {}) has 1 triangle: the mesh is open", a, b));
         } else if (uses > 2) {

@@ -2,7 +2,8 @@
 # Installs the Debian 12 packages Frac needs, only those that are missing.
 set -euo pipefail
 packages=(build-essential cmake pkg-config libfmt-dev catch2 libcli11-dev libeigen3-dev libgmp-dev
-          libpng-dev libmpfr-dev libmpfi-dev libtbb-dev llvm-19-dev libllvmlibc-19-dev clang-format)
+          libpng-dev libmpfr-dev libmpfi-dev libtbb-dev llvm-19-dev libllvmlibc-19-dev clang-format
+          libosd-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

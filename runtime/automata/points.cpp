@@ -41,8 +41,8 @@ num::Matrix<T> convert(const num::Matrix<num::Rational>& m) {
 }
 
 template <typename T>
-std::optional<std::vector<double>> point_along(const ir::Automaton& a, const std::vector<std::size_t>& path,
-                                               std::size_t cycle_start) {
+std::optional<num::Matrix<T>> point_along(const ir::Automaton& a, const std::vector<std::size_t>& path,
+                                          std::size_t cycle_start) {
     auto op = [&](std::size_t arc) -> num::Matrix<T> {
         if constexpr (std::is_same_v<T, num::Rational>)
             return *a.arcs[arc].op.exact;
@@ -57,14 +57,17 @@ std::optional<std::vector<double>> point_along(const ir::Automaton& a, const std
         fixed_point<T>(p, s, convert<T>(ir::direction_basis(s)), convert<T>(ir::direction_coordinates(s)));
     if (!x) return std::nullopt;
     for (std::size_t i = cycle_start; i-- > 0;) *x = op(path[i]) * *x;
-    std::vector<double> out(x->rows());
-    for (std::size_t r = 0; r < x->rows(); ++r) {
-        if constexpr (std::is_same_v<T, num::Rational>)
-            out[r] = (*x)(r, 0).to_double();
-        else
-            out[r] = (*x)(r, 0);
-    }
-    return out;
+    return x;
+}
+
+bool all_exact(const ir::Automaton& a, const std::vector<std::size_t>& path) {
+    for (std::size_t i : path)
+        if (!a.arcs[i].op.exact) return false;
+    return true;
+}
+
+void require_cycle(const std::vector<std::size_t>& path, std::size_t cycle_start) {
+    if (cycle_start >= path.size()) throw std::invalid_argument("periodic_point: the cycle is empty");
 }
 
 } // namespace
@@ -95,15 +98,36 @@ std::vector<double> attractor_point(const ir::Automaton& a, std::size_t state) {
         path.push_back(out.front());
         q = a.arcs[out.front()].to;
     }
-    bool exact = true;
-    for (std::size_t i : path) exact = exact && a.arcs[i].op.exact.has_value();
-    const auto x =
-        exact ? point_along<num::Rational>(a, path, seen[q]) : point_along<double>(a, path, seen[q]);
+    const auto x = periodic_point(a, path, seen[q]);
     if (!x)
         throw std::invalid_argument(
             fmt::format("the cycle {} has no unique fixed point (it does not contract)",
                         ir::path_text(a, std::vector(path.begin() + seen[q], path.end()))));
     return *x;
+}
+
+std::optional<std::vector<double>>
+periodic_point(const ir::Automaton& a, const std::vector<std::size_t>& path, std::size_t cycle_start) {
+    require_cycle(path, cycle_start);
+    if (all_exact(a, path)) {
+        const auto x = point_along<num::Rational>(a, path, cycle_start);
+        if (!x) return std::nullopt;
+        std::vector<double> out(x->rows());
+        for (std::size_t r = 0; r < x->rows(); ++r) out[r] = (*x)(r, 0).to_double();
+        return out;
+    }
+    const auto x = point_along<double>(a, path, cycle_start);
+    if (!x) return std::nullopt;
+    std::vector<double> out(x->rows());
+    for (std::size_t r = 0; r < x->rows(); ++r) out[r] = (*x)(r, 0);
+    return out;
+}
+
+std::optional<num::Matrix<num::Rational>>
+exact_periodic_point(const ir::Automaton& a, const std::vector<std::size_t>& path, std::size_t cycle_start) {
+    require_cycle(path, cycle_start);
+    if (!all_exact(a, path)) return std::nullopt;
+    return point_along<num::Rational>(a, path, cycle_start);
 }
 
 num::Matrix<double> output_matrix(const ir::Automaton& a) {

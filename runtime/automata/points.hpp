@@ -7,6 +7,7 @@
 #include "ir/automaton.hpp"
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 namespace frac::rt {
@@ -20,6 +21,16 @@ void require_well_formed(const ir::Automaton& a);
 // its operators are exact) and map it back along the path. Throws std::invalid_argument when a state
 // on the way has no arc, or when the cycle's operator has no unique fixed point (it does not contract).
 std::vector<double> attractor_point(const ir::Automaton& a, std::size_t state);
+
+// The homogeneous column (in the space of the first arc's source state) of the point at the
+// eventually periodic address path[0] ... path[k - 1] (path[k] ... path[n - 1])^infinity, k =
+// cycle_start < n: the fixed point of the cycle's composite mapped back along the prefix. Exact (then
+// rounded) when every operator on the path is exact. nullopt when the cycle has no unique fixed point.
+std::optional<std::vector<double>>
+periodic_point(const ir::Automaton& a, const std::vector<std::size_t>& path, std::size_t cycle_start);
+// The same point in exact rationals; nullopt also when an operator on the path is not exact.
+std::optional<num::Matrix<num::Rational>>
+exact_periodic_point(const ir::Automaton& a, const std::vector<std::size_t>& path, std::size_t cycle_start);
 
 // Homogeneous column of the initial state's space -> euclidean coordinates of the output space
 // (Automaton::output_dimension() of them), through the projection when there is one.
