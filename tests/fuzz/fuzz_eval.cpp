@@ -7,6 +7,7 @@
 
 #include <fuzzer/FuzzedDataProvider.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -88,11 +89,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         auto eval = frac::driver::make_evaluator(c->module, s.root, 2, options);
         const Interval whole = eval->eval_box(box.data());
         for (int k = 0; k < 5; ++k) {
-            // The corners, then points chosen by the input.
             std::array<double, 2> p;
+            // The corners, then points chosen by the input (clamped: lo + (hi - lo) * t may round past hi).
             for (std::size_t a = 0; a < 2; ++a)
-                p[a] = k < 4 ? ((k >> a) & 1 ? box[a].hi : box[a].lo)
-                             : box[a].lo + (box[a].hi - box[a].lo) * in.ConsumeProbability<double>();
+                p[a] = k < 4
+                           ? ((k >> a) & 1 ? box[a].hi : box[a].lo)
+                           : std::clamp(box[a].lo + (box[a].hi - box[a].lo) * in.ConsumeProbability<double>(),
+                                        box[a].lo, box[a].hi);
             std::array<Interval, 2> point{Interval{p[0], p[0]}, Interval{p[1], p[1]}};
             const Interval at = eval->eval_box(point.data());
             if (!at.is_empty() && !meet(at, whole)) {

@@ -15,11 +15,12 @@ done < <(find "$root/tests/lang" "$root/stdlib" -name '*.frac' -size -64k)
 status=0
 for target in fuzz_frontend fuzz_eval; do
     corpus=$build/corpus/${target#fuzz_}
-    # The frontend from the models; the evaluators' inputs are a few dozen choices, at full length at once.
-    args=(-len_control=0 -max_len=256)
-    [ "$target" = fuzz_frontend ] && args=("$build/seeds" -max_len=8192)
+    # The frontend from the models; the evaluators' inputs are a few dozen choices, at full length at once,
+    # each compiled by the JIT (a second or more under ASan on a busy machine: 10 s before a hang).
+    args=(-len_control=0 -max_len=256 -timeout=10)
+    [ "$target" = fuzz_frontend ] && args=("$build/seeds" -max_len=8192 -timeout=2)
     echo "== $target, $seconds s"
-    "$build/tests/fuzz/$target" "$corpus" "${args[@]}" -max_total_time="$seconds" -timeout=2 \
+    "$build/tests/fuzz/$target" "$corpus" "${args[@]}" -max_total_time="$seconds" \
         -rss_limit_mb=4096 -print_final_stats=1 -artifact_prefix="$build/findings/$target-" \
         > "$build/$target.log" 2>&1 || status=1
     grep -E "^#[0-9]+.*(DONE|cov:)" "$build/$target.log" | tail -1
