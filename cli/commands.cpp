@@ -124,9 +124,18 @@ rt::RssProgress terminal_progress(std::shared_ptr<bool> printed) {
     };
 }
 
+// A work limit: the flag when given, else the environment variable, else the default.
+std::uint64_t limit_of(std::uint64_t flag, const char* env, std::uint64_t fallback) {
+    if (flag > 0) return flag;
+    if (const auto v = positive_env(env, "cells or triangles"))
+        return static_cast<std::uint64_t>(std::min(*v, 1e19));
+    return fallback;
+}
+
 rt::RssResult cover(const std::vector<ir::Interval>& box, int depth, int split, bool keep_cells, int threads,
-                    ir::Evaluator& eval, bool closed_inside = false) {
+                    ir::Evaluator& eval, const WorkLimits& limits, bool closed_inside = false) {
     rt::RssOptions ro;
+    ro.max_cells = limit_of(limits.cells, "FRAC_MAX_CELLS", rt::default_max_cells);
     ro.closed_inside = closed_inside;
     ro.threads = threads;
     ro.depth = depth;
@@ -138,6 +147,11 @@ rt::RssResult cover(const std::vector<ir::Interval>& box, int depth, int split, 
         rt::RssResult r = rt::subdivide(eval, box, ro);
         if (*printed) std::cerr << "\n"; // end the progress line
         return r;
+    } catch (const rt::LimitError& e) {
+        if (*printed) std::cerr << "\n";
+        throw RunError(fmt::format("{}: lower --depth, or raise the limit with --max-cells N (or "
+                                   "FRAC_MAX_CELLS=N)",
+                                   e.what()));
     } catch (const std::invalid_argument& e) {
         throw RunError(e.what());
     }
@@ -149,13 +163,7 @@ namespace {
 
 // The size limit of outputs: output_size_limit, or FRAC_OUTPUT_LIMIT_MB when set to a positive number.
 double output_limit() {
-    if (const char* env = std::getenv("FRAC_OUTPUT_LIMIT_MB")) {
-        char* end = nullptr;
-        const double mb = std::strtod(env, &end);
-        if (end != env && *end == '\0' && mb > 0 && std::isfinite(mb)) return mb * 1e6;
-        throw UsageError(
-            fmt::format("FRAC_OUTPUT_LIMIT_MB must be a positive number of megabytes, not '{}'", env));
-    }
+    if (const auto mb = positive_env("FRAC_OUTPUT_LIMIT_MB", "megabytes")) return *mb * 1e6;
     return output_size_limit;
 }
 
@@ -216,7 +224,7 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
                                      s.name));
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
-    const rt::RssResult full = cover(box, o.depth, o.split, true, engine.threads, *eval);
+    const rt::RssResult full = cover(box, o.depth, o.split, true, engine.threads, *eval, o.limits);
     std::cerr << fmt::format(
         "{}: depth {}, {} boxes evaluated: {} inside, {} outside, {} boundary; {:.3f} s\n", s.name, o.depth,
         full.evaluated, full.inside, full.outside, full.boundary, full.seconds);
@@ -260,14 +268,14 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
 }
 
 int run_dimension(const std::string& file, const std::string& shape, int from, int to, int split,
-                  const EngineOptions& engine) {
+                  const WorkLimits& limits, const EngineOptions& engine) {
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
     if (const front::AutomatonInfo* a = c->module.find_automaton(shape))
         return automaton_dimension(*a, from, to);
     const front::ShapeInfo& s = pick_shape(*c, shape);
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
-    const rt::RssResult r = cover(s.box, to, split, false, engine.threads, *eval);
+    const rt::RssResult r = cover(s.box, to, split, false, engine.threads, *eval, limits);
     rt::DimensionEstimate d;
     try {
         d = rt::box_counting(r, from, to);
@@ -307,8 +315,16 @@ int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions&
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
     // A mesh is of the closed solid {f <= 0}: cells whose faces lie on its surface are inside.
-    const rt::RssResult r = cover(box, o.depth, o.split, true, engine.threads, *eval, true);
-    const rt::Mesh mesh = rt::mesh_cover(r, selection);
+    const rt::RssResult r = cover(box, o.depth, o.split, true, engine.threads, *eval, o.limits, true);
+    rt::Mesh mesh;
+    try {
+        mesh = rt::mesh_cover(r, selection,
+                              limit_of(o.limits.triangles, "FRAC_MAX_TRIANGLES", default_max_triangles));
+    } catch (const rt::LimitError& e) {
+        throw RunError(fmt::format("{}: lower --depth, or raise the limit with --max-triangles N (or "
+                                   "FRAC_MAX_TRIANGLES=N)",
+                                   e.what()));
+    }
     if (mesh.stats.cells == 0) {
         // Nothing to print: say why rather than write an empty file.
         std::string hint;

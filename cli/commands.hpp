@@ -4,15 +4,24 @@
 #include "cli/session.hpp"
 #include "runtime/mesh.hpp"
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
 namespace frac::cli {
 
+// Limits on the cells of a subdivision and the triangles of a mesh (runtime/limits.hpp): --max-cells and
+// --max-triangles, else FRAC_MAX_CELLS and FRAC_MAX_TRIANGLES, else the defaults; 0 here: not given.
+struct WorkLimits {
+    std::uint64_t cells = 0, triangles = 0;
+};
+inline constexpr std::uint64_t default_max_triangles = std::uint64_t{1} << 26; // about 1.5 GB with vertices
+
 struct RenderOptions {
     std::string shape, box, output, kind = "both", ascii, slice, method;
     int depth = 8, split = 2, size = 512;
     bool force = false; // write an SVG over the size limit
+    WorkLimits limits;
 };
 
 // --emit=STAGE prints what a stage of the pipeline produced (driver/pipeline.hpp); --time-passes runs
@@ -33,10 +42,11 @@ struct MeshOptions {
     std::string layout, cells; // automata: "NxM" or "N" (a curve), and the initial state's arcs in cell order
     int depth = 4, split = 2;
     bool force = false; // write a mesh over the size limit
+    WorkLimits limits;
 };
 int run_mesh(const std::string& file, const MeshOptions& options, const EngineOptions& engine);
 int run_dimension(const std::string& file, const std::string& shape, int from, int to, int split,
-                  const EngineOptions& engine);
+                  const WorkLimits& limits, const EngineOptions& engine);
 struct CompileOptions {
     std::vector<std::string> shapes; // none: every shape of the model
     std::string output, header, cpu = "generic", prefix = "frac_";

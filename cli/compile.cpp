@@ -4,41 +4,19 @@
 #include "backend/llvm/aot.hpp"
 #include "backend/llvm/jit.hpp"
 #include "cli/commands.hpp"
+#include "support/atomic_file.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 
 namespace frac::cli {
 namespace fs = std::filesystem;
 
 namespace {
-
-// Fails early, with the system's reason, when `path` cannot be written.
-void check_writable(const std::string& path) {
-    std::ofstream probe(path, std::ios::binary | std::ios::app);
-    if (!probe) throw RunError(fmt::format("cannot write '{}': {}", path, std::strerror(errno)));
-}
-
-// Removes the files the command created unless it succeeded: no empty or half-written model is left.
-class OutputsOnFailure {
-public:
-    void add(const std::string& path) { paths_.push_back(path); }
-    void commit() { paths_.clear(); }
-    ~OutputsOnFailure() {
-        std::error_code ec;
-        for (const std::string& p : paths_) fs::remove(p, ec);
-    }
-
-private:
-    std::vector<std::string> paths_;
-};
 
 std::string header_guard(const std::string& header_path) {
     std::string g = "FRAC_MODEL_";
@@ -80,7 +58,12 @@ std::string check_compile_output(const std::string& path) {
 
 int run_compile(const std::string& file, const CompileOptions& o) {
     if (std::string problem = check_compile_output(o.output); !problem.empty()) throw UsageError(problem);
-    for (const std::string& path : {o.output, o.header})
+    const bool ir_only = ends_with(o.output, ".ll");
+    const std::string ir_path = ir_only       ? o.output
+                                : o.emit_llvm ? fs::path(o.output).replace_extension(".ll").string()
+                                              : std::string();
+    // Every output is written atomically (support/atomic_file.hpp) and checked before any work.
+    for (const std::string& path : {o.output, ir_path, o.header})
         if (!path.empty()) check_output_writable(path);
     jit::AotConfig config;
     config.options.max_terms = o.max_terms;
@@ -97,19 +80,6 @@ int run_compile(const std::string& file, const CompileOptions& o) {
             throw RunError(fmt::format("shape '{}' does not give C names ({}{}_eval_box)", s.name,
                                        config.prefix, s.name));
 
-    const bool ir_only = ends_with(o.output, ".ll");
-    const std::string ir_path = ir_only       ? o.output
-                                : o.emit_llvm ? fs::path(o.output).replace_extension(".ll").string()
-                                              : std::string();
-    OutputsOnFailure outputs;
-    for (const std::string& path : {o.output, ir_path, o.header}) {
-        if (path.empty()) continue;
-        std::error_code ec;
-        const bool existed = fs::exists(path, ec);
-        check_writable(path);
-        if (!existed) outputs.add(path);
-    }
-
     jit::AotInfo info;
     try {
         info = ir_only ? jit::compile_aot(shapes, config, "", ir_path)
@@ -120,13 +90,17 @@ int run_compile(const std::string& file, const CompileOptions& o) {
         throw RunError(e.what());
     }
     if (!o.header.empty()) {
-        std::ofstream h(o.header, std::ios::binary | std::ios::trunc);
-        h << jit::aot_header(shapes, config, info, fs::path(file).filename().string(),
-                             header_guard(o.header));
-        if (!h.flush()) throw RunError(fmt::format("cannot write '{}': {}", o.header, std::strerror(errno)));
+        try {
+            support::write_file_atomically(o.header,
+                                           jit::aot_header(shapes, config, info,
+                                                           fs::path(file).filename().string(),
+                                                           header_guard(o.header)),
+                                           "header");
+        } catch (const std::runtime_error& e) {
+            throw RunError(e.what());
+        }
     }
 
-    outputs.commit();
     std::string names;
     for (const jit::AotShape& s : shapes) names += (names.empty() ? "" : ", ") + s.name;
     std::cerr << fmt::format(

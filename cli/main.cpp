@@ -1,6 +1,7 @@
 // frac: the command-line tool. Thin: it wires the frontend, the engines and the runtime together.
 #include "cli/commands.hpp"
 #include "frontend/suggest.hpp"
+#include "runtime/rss.hpp"
 
 #include <algorithm>
 
@@ -79,6 +80,16 @@ int run(int argc, char** argv) {
         add_set(sub);
     };
 
+    // The work limits of the subdividing commands (runtime/limits.hpp).
+    auto add_cell_limit = [](CLI::App* sub, cli::WorkLimits& limits) {
+        sub->add_option(
+               "--max-cells", limits.cells,
+               fmt::format("most cells the subdivision evaluates and keeps (default: FRAC_MAX_CELLS, "
+                           "else {}); a run foreseen to pass it is refused",
+                           rt::default_max_cells))
+            ->check(CLI::PositiveNumber);
+    };
+
     std::string file, shape, emit, at, box;
     auto* check = app.add_subcommand("check", "parse, check and lower a model; --emit shows a stage");
     check->add_option("file", file, "model file")->required();
@@ -127,6 +138,7 @@ int run(int argc, char** argv) {
         "--slice", render_options.slice,
         "3D shapes: draw the section by the plane AXIS=VALUE (x, y or z), e.g. z=0.5; without it "
         "a 3D shape is drawn as a shaded relief seen from +z (.png)");
+    add_cell_limit(render, render_options.limits);
     add_engine(render);
 
     cli::MeshOptions mesh_options;
@@ -155,6 +167,11 @@ int run(int argc, char** argv) {
     mesh->add_option("-o,--output", mesh_options.output,
                      "mesh file: .stl (binary), .obj or .ply; a curve of an automaton: .svg or .obj");
     mesh->add_flag("--force", mesh_options.force, "write a mesh estimated above 100 MB");
+    add_cell_limit(mesh, mesh_options.limits);
+    mesh->add_option("--max-triangles", mesh_options.limits.triangles,
+                     fmt::format("most triangles of the mesh (default: FRAC_MAX_TRIANGLES, else {})",
+                                 cli::default_max_triangles))
+        ->check(CLI::PositiveNumber);
     add_engine(mesh);
 
     int from = 4, to = 9, split = 2;
@@ -171,6 +188,8 @@ int run(int argc, char** argv) {
     dimension->add_option("--split", split, "parts per axis and level")
         ->check(CLI::Range(2, 4))
         ->capture_default_str();
+    cli::WorkLimits dimension_limits;
+    add_cell_limit(dimension, dimension_limits);
     add_engine(dimension);
 
     cli::TreeOptions tree_options;
@@ -287,7 +306,7 @@ int run(int argc, char** argv) {
         if (*check) return cli::run_check(file, emit, shape, time_passes);
         if (*eval) return cli::run_eval(file, shape, at, box, engine);
         if (*render) return cli::run_render(file, render_options, engine);
-        if (*dimension) return cli::run_dimension(file, shape, from, to, split, engine);
+        if (*dimension) return cli::run_dimension(file, shape, from, to, split, dimension_limits, engine);
         if (*tree) {
             tree_options.matrices = !tree_no_matrices;
             if (!tree_emit.empty() && !tree_options.output.empty())

@@ -1,13 +1,12 @@
 #include "cli/session.hpp"
 
 #include "frontend/suggest.hpp"
+#include "support/atomic_file.hpp"
 
-#include <cerrno>
+#include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
+#include <cstdlib>
 #include <fmt/format.h>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 
@@ -36,6 +35,8 @@ std::unique_ptr<front::Compilation> compile_or_report(const std::string& path, d
                                                       driver::PassTimes* times) {
     driver::CompileOptions options;
     options.stop = stop;
+    if (const auto nodes = positive_env("FRAC_MAX_INLINE_NODES", "expression nodes"))
+        options.limits.max_inline_nodes = static_cast<std::uint64_t>(std::min(*nodes, 1e18));
     options.overrides = constant_overrides;
     options.times = times;
     auto c = driver::compile_file(path, options);
@@ -132,18 +133,22 @@ ConstantValue evaluate_constant(const std::string& text, const std::string& what
     return v;
 }
 
+std::optional<double> positive_env(const char* name, const char* unit) {
+    const char* env = std::getenv(name);
+    if (!env) return std::nullopt;
+    char* end = nullptr;
+    const double v = std::strtod(env, &end);
+    if (end != env && *end == '\0' && v > 0 && std::isfinite(v)) return v;
+    throw UsageError(fmt::format("{} must be a positive number of {}, not '{}'", name, unit, env));
+}
+
 bool ends_with(const std::string& s, const std::string& suffix) {
     return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 void check_output_writable(const std::string& path) {
-    std::error_code ec;
-    const bool existed = std::filesystem::exists(path, ec);
-    {
-        std::ofstream probe(path, std::ios::binary | std::ios::app);
-        if (!probe) throw UsageError(fmt::format("cannot write '{}': {}", path, std::strerror(errno)));
-    }
-    if (!existed) std::filesystem::remove(path, ec);
+    if (std::string problem = support::output_problem(path); !problem.empty())
+        throw UsageError(fmt::format("cannot write '{}': {}", path, problem));
 }
 
 std::vector<ir::Interval> parse_box(const std::string& text, int dimension) {

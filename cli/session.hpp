@@ -43,6 +43,10 @@ ConstantValue evaluate_constant(const std::string& text, const std::string& what
 
 bool ends_with(const std::string& s, const std::string& suffix);
 
+// A positive number from the environment variable `name`, or nullopt when it is not set; a UsageError
+// naming the variable and `unit` when it is set to anything else.
+std::optional<double> positive_env(const char* name, const char* unit);
+
 // Throws UsageError when `path` cannot be written (checked before any work; leaves no file behind).
 void check_output_writable(const std::string& path);
 

@@ -6,6 +6,7 @@
 
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/jit.hpp"
+#include "frontend/inline_size.hpp"
 #include "frontend/resolve.hpp"
 #include "frontend/topology.hpp"
 #include "ir/specialize.hpp"
@@ -83,7 +84,11 @@ void run_frontend(front::Compilation& c, const CompileOptions& options) {
     if (reached(Stage::constraints)) return;
     timed(options.times, stage_name(Stage::constraints), [&] { front::expand_topology(c.program, c.diags); });
     if (reached(Stage::resolve)) return;
-    timed(options.times, stage_name(Stage::resolve), [&] { front::resolve_names(c.program, c.diags); });
+    timed(options.times, stage_name(Stage::resolve), [&] {
+        front::resolve_names(c.program, c.diags);
+        // Before anything inlines: a definition too large inlined is refused at once (inline_size.hpp).
+        if (!c.diags.has_errors()) front::check_inline_size(c.program, options.limits, c.diags);
+    });
     if (reached(Stage::typecheck)) return;
     const bool resolve_errors = c.diags.has_errors();
     timed(options.times, stage_name(Stage::typecheck),

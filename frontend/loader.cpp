@@ -19,6 +19,7 @@ namespace frac::front {
 namespace {
 
 constexpr std::size_t max_file_bytes = 16u << 20;
+constexpr std::size_t max_import_depth = 64; // files open at once along a chain of imports
 
 bool read_file(const std::string& path, std::string& text, std::string& why) {
     std::error_code ec;
@@ -169,6 +170,13 @@ public:
 private:
     void import(const Item& it, const std::filesystem::path& dir) {
         const std::string& spec = it.name;
+        if (loading_->size() >= max_import_depth) {
+            // Each nested import holds its file's text and a frame of the loader.
+            c_.diags.error(it.loc, fmt::format("imports nested deeper than the limit of {} files: import "
+                                               "the modules side by side from one file",
+                                               max_import_depth));
+            return;
+        }
         const bool library = spec.find('/') == std::string::npos && spec.find(".frac") == std::string::npos;
         std::string name, text, key;
         std::filesystem::path module_dir = dir;
@@ -202,6 +210,13 @@ private:
             }
             if (seen_.count(key + " as " + it.alias)) return; // imported already
             std::string why;
+            std::error_code kind;
+            if (std::filesystem::exists(path, kind) && !std::filesystem::is_regular_file(path, kind) &&
+                !std::filesystem::is_directory(path, kind)) {
+                // A device or a pipe may never end or block (/dev/stdin): a module is a file.
+                c_.diags.error(it.loc, fmt::format("cannot import '{}': not a regular file", path.string()));
+                return;
+            }
             if (!read_file(path.string(), text, why)) {
                 c_.diags.error(it.loc, fmt::format("cannot read '{}': {}", path.string(), why));
                 return;

@@ -96,7 +96,8 @@ private:
     }
 
     TermBound compute(NodeId id) {
-        const ir::Node& n = g_[id];
+        // A copy: form() adds nodes to the graph, which may move its storage (a reference dangled).
+        const ir::Node n = g_[id];
         if (!depends(id)) return index_free(id);
         auto arg = [&](int k) { return form(n.args[static_cast<std::size_t>(k)]); };
         switch (n.op) {

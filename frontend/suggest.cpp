@@ -26,9 +26,13 @@ std::optional<std::string> closest_name(const std::string& name, const std::vect
     const std::size_t limit =
         name.size() <= 2 ? 0 : std::max<std::size_t>(1, std::min<std::size_t>(2, name.size() / 3));
     std::optional<std::string> best;
+    // The distance takes time quadratic in the lengths (a name of 10^6 letters took minutes): longer names
+    // get no suggestion, and a length difference above the limit is already too far.
+    constexpr std::size_t max_suggested_length = 128;
+    if (name.size() > max_suggested_length) return best;
     std::size_t best_distance = limit + 1;
     for (const std::string& c : candidates) {
-        if (c == name) continue;
+        if (c == name || c.size() > name.size() + limit || name.size() > c.size() + limit) continue;
         const std::size_t d = edit_distance(name, c);
         if (d < best_distance) {
             best_distance = d;

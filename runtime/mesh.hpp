@@ -21,6 +21,7 @@
 #pragma once
 
 #include "runtime/cover.hpp"
+#include "runtime/limits.hpp"
 
 #include <array>
 #include <cstdint>
@@ -55,8 +56,10 @@ struct Mesh {
 };
 
 // The mesh of the union of the selected leaves of a 3D cover computed with keep_cells. An empty
-// selection gives an empty mesh. Throws std::invalid_argument for a 2D cover or one without cells.
-Mesh mesh_cover(const Cover& r, MeshSelection selection);
+// selection gives an empty mesh. Throws std::invalid_argument for a 2D cover or one without cells, and
+// a LimitError when the mesh would have more than `max_triangles` triangles (0: no limit), found once the
+// merged faces are known, before the triangles are made.
+Mesh mesh_cover(const Cover& r, MeshSelection selection, std::uint64_t max_triangles = 0);
 
 // Sum of the volumes of the selected leaves, from the exact grid geometry (long double sum).
 double selected_volume(const Cover& r, MeshSelection selection);

@@ -1,5 +1,6 @@
 // The mesh writers: binary STL, OBJ and binary PLY, chosen by the path's extension (mesh.hpp).
 #include "runtime/mesh.hpp"
+#include "support/atomic_file.hpp"
 
 #include <fmt/format.h>
 
@@ -22,23 +23,11 @@ using u64 = std::uint64_t;
 
 namespace {
 
-// Buffered binary file; throws naming the path, removes the file on failure.
+// Buffered binary output, written atomically (support/atomic_file.hpp): throws naming the path; a failed
+// or interrupted write leaves the previous file in place.
 class OutFile {
 public:
-    OutFile(const std::string& path, const char* what) : path_(path), what_(what) {
-        fp_ = std::fopen(path.c_str(), "wb");
-        if (!fp_)
-            throw std::runtime_error(
-                fmt::format("cannot write {} '{}': {}", what_, path_, std::strerror(errno)));
-    }
-    OutFile(const OutFile&) = delete;
-    OutFile& operator=(const OutFile&) = delete;
-    ~OutFile() {
-        if (fp_) { // not closed: an exception is on its way
-            std::fclose(fp_);
-            std::remove(path_.c_str());
-        }
-    }
+    OutFile(const std::string& path, const char* what) : file_(path, what) {}
     void bytes(const void* p, std::size_t n) {
         const auto* c = static_cast<const char*>(p);
         buf_.insert(buf_.end(), c, c + n);
@@ -51,13 +40,7 @@ public:
     void f32(float v) { le(std::bit_cast<u32>(v)); }
     void close() {
         flush();
-        FILE* fp = fp_;
-        fp_ = nullptr;
-        if (std::fclose(fp) != 0) {
-            const std::string why = std::strerror(errno);
-            std::remove(path_.c_str());
-            throw std::runtime_error(fmt::format("cannot write {} '{}': {}", what_, path_, why));
-        }
+        file_.commit();
     }
 
 private:
@@ -68,14 +51,10 @@ private:
         bytes(b, sizeof(T));
     }
     void flush() {
-        if (!buf_.empty() && std::fwrite(buf_.data(), 1, buf_.size(), fp_) != buf_.size())
-            throw std::runtime_error(
-                fmt::format("cannot write {} '{}': {}", what_, path_, std::strerror(errno)));
+        file_.write(buf_.data(), buf_.size());
         buf_.clear();
     }
-    std::string path_;
-    const char* what_;
-    FILE* fp_ = nullptr;
+    support::AtomicFile file_;
     std::vector<char> buf_;
 };
 

@@ -1,4 +1,5 @@
 #include "runtime/picture.hpp"
+#include "support/atomic_file.hpp"
 
 #include <fmt/format.h>
 #include <png.h>
@@ -8,7 +9,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <iterator>
 #include <stdexcept>
 
@@ -153,31 +153,26 @@ std::string num_text(double v, int decimals) {
     return s;
 }
 
-// Writes an SVG incrementally so that a large cover never sits in memory twice.
+// Writes an SVG incrementally so that a large cover never sits in memory twice; atomically, so that a
+// failed or interrupted write leaves the previous file in place.
 class SvgWriter {
 public:
-    explicit SvgWriter(const std::string& path) : path_(path), os_(path, std::ios::binary | std::ios::trunc) {
-        if (!os_)
-            throw std::runtime_error(fmt::format("cannot write SVG '{}': {}", path, std::strerror(errno)));
-    }
+    explicit SvgWriter(const std::string& path) : file_(path, "SVG") {}
     fmt::memory_buffer& buf() { return buf_; }
     void maybe_flush() {
         if (buf_.size() > (1u << 20)) flush();
     }
     void close() {
         flush();
-        os_.close();
-        if (!os_) throw std::runtime_error(fmt::format("cannot write SVG '{}': write failed", path_));
+        file_.commit();
     }
 
 private:
     void flush() {
-        os_.write(buf_.data(), static_cast<std::streamsize>(buf_.size()));
+        file_.write(buf_.data(), buf_.size());
         buf_.clear();
-        if (!os_) throw std::runtime_error(fmt::format("cannot write SVG '{}': write failed", path_));
     }
-    std::string path_;
-    std::ofstream os_;
+    support::AtomicFile file_;
     fmt::memory_buffer buf_;
 };
 
@@ -279,8 +274,7 @@ void write_png(const Image& image, const std::string& path) {
     if (image.width < 1 || image.height < 1 ||
         image.rgb.size() != static_cast<std::size_t>(image.width) * image.height * 3)
         throw std::invalid_argument(fmt::format("write_png '{}': malformed image", path));
-    FILE* fp = std::fopen(path.c_str(), "wb");
-    if (!fp) throw std::runtime_error(fmt::format("cannot write PNG '{}': {}", path, std::strerror(errno)));
+    support::AtomicFile out(path, "PNG");
     // The simplified libpng API reports errors by return value (no setjmp/longjmp through C++).
     png_image png;
     std::memset(&png, 0, sizeof png);
@@ -288,15 +282,11 @@ void write_png(const Image& image, const std::string& path) {
     png.width = static_cast<png_uint_32>(image.width);
     png.height = static_cast<png_uint_32>(image.height);
     png.format = PNG_FORMAT_RGB;
-    const int ok = png_image_write_to_stdio(&png, fp, 0, image.rgb.data(), 0, nullptr);
+    const int ok = png_image_write_to_stdio(&png, out.stream(), 0, image.rgb.data(), 0, nullptr);
     const std::string reason = ok ? "" : png.message;
     png_image_free(&png);
-    const bool closed = std::fclose(fp) == 0;
-    if (!ok || !closed) {
-        const std::string why = !ok ? reason : std::string(std::strerror(errno));
-        std::remove(path.c_str()); // no truncated file left behind
-        throw std::runtime_error(fmt::format("cannot write PNG '{}': {}", path, why));
-    }
+    if (!ok) out.fail(reason);
+    out.commit();
 }
 
 void write_png(const Cover& r, const std::string& path, PictureKind kind, int pixels) {

@@ -18,6 +18,16 @@ namespace frac::rt {
 
 namespace {
 
+// The cell budget (RssOptions::max_cells): the growth of the levels is trusted once a level has this
+// many undecided cells (before, every cell of a coarse level may be undecided).
+constexpr std::size_t min_cells_for_growth = 4096;
+
+std::string byte_text(double bytes) {
+    if (bytes >= 1e12) return fmt::format("{:.3g} TB", bytes / 1e12);
+    if (bytes >= 1e9) return fmt::format("{:.3g} GB", bytes / 1e9);
+    return fmt::format("{:.3g} MB", bytes / 1e6);
+}
+
 using Clock = std::chrono::steady_clock;
 
 // Position of a cell in the grid of its level, and the function it evaluates (0: the shape's, else
@@ -109,6 +119,7 @@ public:
         push({0, 0, 0});
         finish_level();
         for (int k = 1; k <= depth; ++k) {
+            check_budget(k, next_.size());
             std::vector<Pos> parents;
             parents.swap(next_);
             start_level(k);
@@ -125,6 +136,34 @@ public:
     }
 
 private:
+    // Before level k, whose `parents` undecided cells give exactly parents * split^d cells: refuses when
+    // that passes max_cells, or when the growth of the last level, carried on to the depth, foretells a
+    // total past max_cells. So a run stops before it has spent the memory, mostly after a few cheap
+    // levels; a growth that slows down later makes the estimate high (raise the limit to go on).
+    void check_budget(int k, std::size_t parents) const {
+        const std::uint64_t limit = r_.options.max_cells;
+        if (limit == 0) return;
+        const double per_parent = std::pow(static_cast<double>(r_.split), d_);
+        const double next = static_cast<double>(parents) * per_parent;
+        const double done = static_cast<double>(r_.evaluated);
+        // Growth of the undecided cells per level, from the last two levels (at least 1).
+        const double before =
+            k >= 2 ? static_cast<double>(r_.levels[static_cast<std::size_t>(k - 2)].undecided) : 1;
+        const double growth =
+            std::clamp(before > 0 ? static_cast<double>(parents) / before : per_parent, 1.0, per_parent);
+        double estimate = done, frontier = static_cast<double>(parents);
+        for (int j = k; j <= r_.depth; ++j, frontier *= growth) estimate += frontier * per_parent;
+        const bool exact = done + next > static_cast<double>(limit);
+        const bool foretold = parents >= min_cells_for_growth && estimate > static_cast<double>(limit);
+        if (!exact && !foretold) return;
+        const double bytes =
+            estimate * (r_.options.keep_cells ? sizeof(Cell) + sizeof(Pos) / 4.0 : sizeof(Pos) / 4.0);
+        throw LimitError(fmt::format("depth {}: about {:.3g} cells to evaluate (about {}), more than the "
+                                     "limit of {} cells (foreseen after level {} of {})",
+                                     r_.depth, estimate, byte_text(bytes), limit, k - 1, r_.depth),
+                         estimate, limit);
+    }
+
     void start_level(int k) {
         level_ = k;
         n_ = grid::ipow(r_.split, k);

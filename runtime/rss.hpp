@@ -20,6 +20,7 @@
 
 #include "ir/evaluator.hpp"
 #include "runtime/cover.hpp"
+#include "runtime/limits.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -46,7 +47,15 @@ struct RssOptions {
     // For meshes of solids (cells whose faces lie on the solid's boundary are inside); boundary covers
     // (pictures, dimension) keep the default, since a cell with hi = 0 may hold boundary points.
     bool closed_inside = false;
+    // Most cells evaluated (and, with keep_cells, kept in memory); 0: no limit. The run refuses before
+    // a level that would pass it, and as soon as the growth of the last level foretells that the depth
+    // would pass it (a LimitError, with the estimate).
+    std::uint64_t max_cells = 0;
 };
+
+// The default of the command line's --max-cells: 2^27 cells, about 2 GB kept (16 bytes a cell, and the
+// frontier of undecided cells beside them) and a few seconds to a minute of evaluation.
+inline constexpr std::uint64_t default_max_cells = std::uint64_t{1} << 27;
 
 // Min/max pruning (ir/specialize.hpp, switched by EvalOptions::prune): an undecided cell far enough
 // above the depth limit asks its evaluator for a simplified function, which its descendants then

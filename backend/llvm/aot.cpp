@@ -7,6 +7,7 @@
 #include "backend/llvm/pipeline.hpp"
 #include "backend/llvm/tables.hpp"
 #include "ir/external.hpp"
+#include "support/atomic_file.hpp"
 
 #include <llvm/IR/Constants.h>
 #include <llvm/IR/DerivedTypes.h>
@@ -216,17 +217,25 @@ void add_releases(llvm::Module& m,
     llvm::appendToGlobalDtors(m, f, 0);
 }
 
-void write_file(const std::string& path, llvm::sys::fs::OpenFlags flags,
-                const std::function<void(llvm::raw_fd_ostream&)>& write) {
-    std::error_code ec;
-    llvm::raw_fd_ostream os(path, ec, flags);
-    if (ec) throw JitError("cannot write '" + path + "': " + ec.message());
-    write(os);
-    os.close();
-    if (os.has_error()) {
-        const std::string why = os.error().message();
-        os.clear_error();
-        throw JitError("cannot write '" + path + "': " + why);
+// Written atomically (support/atomic_file.hpp): a failed or interrupted write leaves the previous file.
+void write_file(const std::string& path, const std::function<void(llvm::raw_fd_ostream&)>& write) {
+    try {
+        support::AtomicFile file(path, "");
+        {
+            llvm::raw_fd_ostream os(file.descriptor(), /*shouldClose=*/false);
+            write(os);
+            os.flush();
+            if (os.has_error()) {
+                const std::string why = os.error().message();
+                os.clear_error(); // an error left set is fatal in the destructor
+                file.fail(why);
+            }
+        }
+        file.commit();
+    } catch (const JitError&) {
+        throw;
+    } catch (const std::runtime_error& e) {
+        throw JitError(e.what());
     }
 }
 
@@ -274,10 +283,9 @@ AotInfo compile_aot(const std::vector<AotShape>& shapes, const AotConfig& config
     optimize(module, target.machine.get());
 
     if (!llvm_ir_path.empty())
-        write_file(llvm_ir_path, llvm::sys::fs::OF_Text,
-                   [&](llvm::raw_fd_ostream& os) { module.print(os, nullptr); });
+        write_file(llvm_ir_path, [&](llvm::raw_fd_ostream& os) { module.print(os, nullptr); });
     if (!object_path.empty()) {
-        write_file(object_path, llvm::sys::fs::OF_None, [&](llvm::raw_fd_ostream& os) {
+        write_file(object_path, [&](llvm::raw_fd_ostream& os) {
             llvm::legacy::PassManager pm;
             if (target.machine->addPassesToEmitFile(pm, os, nullptr, llvm::CodeGenFileType::ObjectFile))
                 throw JitError("LLVM cannot write object files for " + target.info.triple);

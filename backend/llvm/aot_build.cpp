@@ -8,11 +8,13 @@
 #include "backend/llvm/aot.hpp"
 #include "backend/llvm/jit.hpp"
 #include "backend/llvm/pipeline.hpp"
+#include "support/atomic_file.hpp"
 
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
 #include <dlfcn.h>
+#include <fcntl.h>
 #include <filesystem>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -82,7 +84,9 @@ std::string find_archive(const std::string& name) {
                    "); build the " + target + " target or set FRAC_AOT_RUNTIME");
 }
 
-// A fresh private directory for intermediate files, removed on scope exit.
+// A fresh private directory for intermediate files, removed on scope exit -- and when this process is
+// killed: a cleaner process (sh) waits for the end of a pipe that only this process and the tools it runs
+// hold open, then removes the directory. No destructor runs on SIGKILL; the pipe closes all the same.
 class TempDir {
 public:
     TempDir() {
@@ -90,17 +94,49 @@ public:
         if (!mkdtemp(pattern.data()))
             throw JitError(std::string("cannot create a temporary directory: ") + std::strerror(errno));
         path_ = pattern;
+        start_cleaner();
     }
     ~TempDir() {
         std::error_code ec;
         fs::remove_all(path_, ec);
+        if (cleaner_ > 0) {
+            ::close(alive_fd_); // the cleaner sees the end of its input, finds nothing left and exits
+            while (waitpid(cleaner_, nullptr, 0) < 0 && errno == EINTR) {
+            }
+        }
     }
     TempDir(const TempDir&) = delete;
     TempDir& operator=(const TempDir&) = delete;
     std::string file(const char* name) const { return (path_ / name).string(); }
 
 private:
+    void start_cleaner() {
+        int fds[2];
+        if (pipe2(fds, O_CLOEXEC) != 0) return; // no cleaner: the destructor still removes the directory
+        // The write end is inherited by the tools (ld, objcopy, c++): the directory outlives them.
+        (void)fcntl(fds[1], F_SETFD, 0);
+        posix_spawn_file_actions_t actions;
+        posix_spawn_file_actions_init(&actions);
+        posix_spawn_file_actions_adddup2(&actions, fds[0], STDIN_FILENO);
+        posix_spawn_file_actions_addclose(&actions, fds[1]);
+        const std::string dir = path_.string();
+        const char* argv[] = {
+            "sh",        "-c",   "cat >/dev/null; exec rm -rf -- \"$1\"", "frac-compile-cleanup",
+            dir.c_str(), nullptr};
+        pid_t pid = 0;
+        const int err = posix_spawnp(&pid, "sh", &actions, nullptr, const_cast<char* const*>(argv), environ);
+        posix_spawn_file_actions_destroy(&actions);
+        ::close(fds[0]);
+        if (err != 0) {
+            ::close(fds[1]);
+            return;
+        }
+        cleaner_ = pid;
+        alive_fd_ = fds[1];
+    }
     fs::path path_;
+    pid_t cleaner_ = -1;
+    int alive_fd_ = -1;
 };
 
 // A loaded compiled model: the C functions of its one shape (docs/c-abi.md), unloaded with the last
@@ -195,7 +231,7 @@ AotInfo build_aot(const std::vector<AotShape>& shapes, const AotConfig& config, 
     std::vector<std::string> link = {tool(FRAC_AOT_LD, "ld"), "-r", "-o", combined, generated};
     link.insert(link.end(), archives.begin(), archives.end());
     run_tool(link, "linking the run-time support into the model");
-    const std::string object = ends_with(output, ".o") ? output : tmp.file("model.o");
+    const std::string object = tmp.file("model.o");
     // Local symbols in COMDAT groups would still be merged with another model's copies (and the
     // references to the discarded copy break): the groups go, each model keeps its own code.
     std::vector<std::string> localize = {tool(FRAC_AOT_OBJCOPY, "objcopy"), "--strip-debug",
@@ -207,10 +243,18 @@ AotInfo build_aot(const std::vector<AotShape>& shapes, const AotConfig& config, 
     localize.push_back(combined);
     localize.push_back(object);
     run_tool(localize, "keeping only the model's functions global");
-    if (ends_with(output, ".so"))
-        run_tool({tool(FRAC_AOT_CXX, "c++"), "-shared", "-o", output,
+    const bool shared = ends_with(output, ".so");
+    const std::string built = shared ? tmp.file("model.so") : object;
+    if (shared)
+        run_tool({tool(FRAC_AOT_CXX, "c++"), "-shared", "-o", built,
                   "-Wl,-soname," + fs::path(output).filename().string(), object, "-Wl,-z,noexecstack", "-lm"},
                  "linking the shared library");
+    // The tools wrote in the private directory; the output appears whole or not at all.
+    try {
+        support::copy_file_atomically(built, output, shared ? "shared library" : "object file");
+    } catch (const std::runtime_error& e) {
+        throw JitError(e.what());
+    }
     return info;
 }
 

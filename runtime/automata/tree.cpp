@@ -2,13 +2,13 @@
 
 #include "ir/automaton_check.hpp"
 #include "runtime/automata/points.hpp"
+#include "support/atomic_file.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -302,39 +302,48 @@ void write_tree_png(const ir::Automaton& a, int depth, const std::string& path, 
 
 void write_tree_svg(const ir::Automaton& a, int depth, const std::string& path) {
     const View v = view_of(a, depth, 1024);
-    std::ofstream os(path);
-    if (!os) throw std::runtime_error(fmt::format("cannot write {}", path));
-    os << fmt::format(
+    support::AtomicFile out(path, "SVG"); // a failed or interrupted write leaves the old file
+    std::string os;
+    const auto spill = [&] { // the text goes out by the megabyte, never whole in memory
+        if (os.size() < (1u << 20)) return;
+        out.write(os);
+        os.clear();
+    };
+    os += fmt::format(
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" viewBox=\"0 0 {} {}\">\n", v.w,
         v.h, v.w, v.h);
-    os << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-    leaf_shapes(a, depth,
-                [&](std::size_t s, ir::Primitive::Kind kind, const std::vector<std::array<double, 2>>& pts) {
-                    const auto c = state_colour(s);
-                    const std::string colour = fmt::format("#{:02x}{:02x}{:02x}", c[0], c[1], c[2]);
-                    if (kind == ir::Primitive::Kind::points || pts.size() == 1) {
-                        for (const auto& p : pts) {
-                            const auto q = v.pixel(p);
-                            os << fmt::format("<circle cx=\"{:.3f}\" cy=\"{:.3f}\" r=\"0.8\" fill=\"{}\"/>\n",
-                                              q[0], q[1], colour);
-                        }
-                        return;
-                    }
-                    std::string list;
-                    for (const auto& p : pts) {
-                        const auto q = v.pixel(p);
-                        list += fmt::format("{}{:.3f},{:.3f}", list.empty() ? "" : " ", q[0], q[1]);
-                    }
-                    if (kind == ir::Primitive::Kind::polygon)
-                        os << fmt::format(
-                            "<polygon points=\"{}\" fill=\"{}\" stroke=\"{}\" stroke-width=\"0.3\"/>\n", list,
-                            colour, colour);
-                    else
-                        os << fmt::format(
-                            "<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"1\"/>\n",
-                            list, colour);
-                });
-    if (!os) throw std::runtime_error(fmt::format("cannot write {}", path));
+    os += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+    leaf_shapes(
+        a, depth,
+        [&](std::size_t s, ir::Primitive::Kind kind, const std::vector<std::array<double, 2>>& pts) {
+            const auto c = state_colour(s);
+            const std::string colour = fmt::format("#{:02x}{:02x}{:02x}", c[0], c[1], c[2]);
+            if (kind == ir::Primitive::Kind::points || pts.size() == 1) {
+                for (const auto& p : pts) {
+                    const auto q = v.pixel(p);
+                    os += fmt::format("<circle cx=\"{:.3f}\" cy=\"{:.3f}\" r=\"0.8\" fill=\"{}\"/>\n", q[0],
+                                      q[1], colour);
+                }
+                spill();
+                return;
+            }
+            std::string list;
+            for (const auto& p : pts) {
+                const auto q = v.pixel(p);
+                list += fmt::format("{}{:.3f},{:.3f}", list.empty() ? "" : " ", q[0], q[1]);
+            }
+            if (kind == ir::Primitive::Kind::polygon)
+                os += fmt::format("<polygon points=\"{}\" fill=\"{}\" stroke=\"{}\" stroke-width=\"0.3\"/>\n",
+                                  list, colour, colour);
+            else
+                os +=
+                    fmt::format("<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"1\"/>\n",
+                                list, colour);
+            spill();
+        });
+    os += "</svg>\n";
+    out.write(os);
+    out.commit();
 }
 
 } // namespace frac::rt
