@@ -2,10 +2,12 @@
 // (runtime/automata/analysis).
 #include "cli/commands.hpp"
 
+#include "ir/automaton_check.hpp"
 #include "runtime/automata/analysis.hpp"
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <stdexcept>
@@ -145,13 +147,32 @@ void print_operator(const ir::Automaton& a, const rt::OperatorAnalysis& o) {
                                  num::midpoint(l2.modulus()));
     }
     // The arcs to other states place copies of their curves around this fixed point (seed 004's T^l,
-    // T^r into the junction state i).
-    std::vector<std::string> copies;
-    for (const ir::Arc& arc : a.arcs)
-        if (arc.from == o.state && arc.to != o.state) copies.push_back(a.states[arc.to].name);
-    if (!copies.empty())
-        std::cout << fmt::format("  junction: the copies of {} accumulate at the fixed point\n",
-                                 fmt::join(copies, ", "));
+    // T^r into the junction state i): along v2 when their control polygons have a component on it.
+    for (const rt::OperatorAnalysis::Copy& copy : o.copies) {
+        const ir::Arc& arc = a.arcs[copy.arc];
+        const char* along = copy.along == rt::OperatorAnalysis::Copy::Along::yes
+                                ? "has a component on v2: its half-tangent is along v2"
+                            : copy.along == rt::OperatorAnalysis::Copy::Along::no
+                                ? "has no component on v2: its half-tangent is another eigenvector's"
+                                : "has components on v2 that contain 0: undecided";
+        std::cout << fmt::format("  junction: the copy of {} through {} {}\n", a.states[arc.to].name,
+                                 ir::arc_name(a, copy.arc), along);
+    }
+    if (o.behaviour == rt::Behaviour::spiral || o.behaviour == rt::Behaviour::oscillation) {
+        std::vector<std::string> copies;
+        for (const ir::Arc& arc : a.arcs)
+            if (arc.from == o.state && arc.to != o.state) copies.push_back(a.states[arc.to].name);
+        if (!copies.empty())
+            std::cout << fmt::format(
+                "  junction: the copies of {} {} into the fixed point, with no tangent\n",
+                fmt::join(copies, ", "), o.behaviour == rt::Behaviour::spiral ? "spiral" : "oscillate");
+    }
+    const bool all_along =
+        std::all_of(o.copies.begin(), o.copies.end(), [](const rt::OperatorAnalysis::Copy& c) {
+            return c.along == rt::OperatorAnalysis::Copy::Along::yes;
+        });
+    if (o.copies.size() > 1 && all_along)
+        std::cout << "  junction: G1, the copies meet at the fixed point along the one line ±v2\n";
 }
 
 } // namespace

@@ -141,6 +141,12 @@ std::optional<IVector> krawczyk(const EigenSystem& s, const std::vector<double>&
     return std::nullopt;
 }
 
+IVector enclose_vector(const std::vector<Rational>& x) {
+    IVector out;
+    for (const Rational& r : x) out.push_back(num::enclose(r));
+    return out;
+}
+
 // ---- Exact side.
 
 Rational evaluate(const std::vector<Rational>& p, const Rational& x) {
@@ -335,6 +341,49 @@ void c1_condition(OperatorAnalysis& o) {
     o.c1_condition = lambda.sign() > 0 && lambda >= rival;
 }
 
+// The copies' components on v2 (see OperatorAnalysis::Copy): exactly when λ2 and the operators are
+// exact, else on a verified left eigenvector.
+void copies_along_v2(const ir::Automaton& a, OperatorAnalysis& o) {
+    const ir::Operator& t = a.arcs[o.arc].op;
+    const Eigenpair& l2 = o.others.front();
+    std::optional<std::vector<Rational>> exact_left;
+    if (t.exact && l2.exact) exact_left = exact_eigenvector(num::transpose(*t.exact), *l2.exact, false);
+    IVector left;
+    if (!exact_left) {
+        const std::size_t n = t.rows();
+        Eigen::MatrixXd tt(n, n);
+        for (std::size_t r = 0; r < n; ++r)
+            for (std::size_t c = 0; c < n; ++c) tt(r, c) = t.nearest(c, r);
+        const Eigen::EigenSolver<Eigen::MatrixXd> solver(tt);
+        Eigen::Index nearest = 0;
+        for (Eigen::Index i = 0; i < solver.eigenvalues().size(); ++i)
+            if (std::abs(solver.eigenvalues()[i] - l2.re) < std::abs(solver.eigenvalues()[nearest] - l2.re))
+                nearest = i;
+        std::vector<double> w(n), zero(n, 0.0);
+        for (std::size_t k = 0; k < n; ++k) w[k] = solver.eigenvectors()(k, nearest).real();
+        const Eigenpair e = verify_eigenpair(num::transpose(t.enclosure), l2.re, 0, w, zero, false);
+        if (e.verified) left = e.vector_re;
+    }
+    for (std::size_t i = 0; i < a.arcs.size(); ++i) {
+        const ir::Arc& arc = a.arcs[i];
+        if (arc.from != o.state || arc.to == o.state) continue;
+        OperatorAnalysis::Copy copy{i};
+        if (exact_left && arc.op.exact) {
+            const Matrix<Rational> comps =
+                Matrix<Rational>(num::transpose(Matrix<Rational>::column(*exact_left))) * *arc.op.exact;
+            copy.along = OperatorAnalysis::Copy::Along::no;
+            for (std::size_t c = 0; c < comps.cols(); ++c)
+                if (!comps(0, c).is_zero()) copy.along = OperatorAnalysis::Copy::Along::yes;
+        } else if (exact_left || !left.empty()) {
+            const IVector w = exact_left ? enclose_vector(*exact_left) : left;
+            const Matrix<Interval> comps = num::transpose(Matrix<Interval>::column(w)) * arc.op.enclosure;
+            for (std::size_t c = 0; c < comps.cols(); ++c)
+                if (comps(0, c).lo > 0 || comps(0, c).hi < 0) copy.along = OperatorAnalysis::Copy::Along::yes;
+        }
+        o.copies.push_back(copy);
+    }
+}
+
 OperatorAnalysis analyze_operator(const ir::Automaton& a, std::size_t arc) {
     const ir::Operator& op = a.arcs[arc].op;
     const std::size_t n = op.rows();
@@ -377,6 +426,7 @@ OperatorAnalysis analyze_operator(const ir::Automaton& a, std::size_t arc) {
     });
     classify(o, n);
     c1_condition(o);
+    if (o.behaviour == Behaviour::tangent) copies_along_v2(a, o);
     return o;
 }
 
@@ -392,12 +442,6 @@ std::vector<Rational> apply(const Matrix<Rational>& t, const std::vector<Rationa
     const Matrix<Rational> y = t * Matrix<Rational>::column(x);
     std::vector<Rational> out(y.rows());
     for (std::size_t i = 0; i < out.size(); ++i) out[i] = y(i, 0);
-    return out;
-}
-
-IVector enclose_vector(const std::vector<Rational>& x) {
-    IVector out;
-    for (const Rational& r : x) out.push_back(num::enclose(r));
     return out;
 }
 

@@ -69,6 +69,14 @@ struct OperatorAnalysis {
     std::optional<std::size_t> edge; // index into `others`
     std::optional<bool> c1_condition;
     std::optional<num::Rational> c1_rival; // the largest other modulus it is compared with (0: none)
+    // Seed 004, sec. 4: the arcs from this state to others place copies of their curves, whose control
+    // polygons are the arcs' columns; a copy approaches the fixed point along v2 when a column has a
+    // non-zero component w2^T p on v2 (w2: the left eigenvector). Analysed for a half-tangent only.
+    struct Copy {
+        std::size_t arc = 0;
+        enum class Along { yes, no, undecided } along = Along::undecided;
+    };
+    std::vector<Copy> copies;
 };
 
 // Two pieces T_i(A) and T_j(A) of a curve meet where T_i x_j = T_j x_i (x_k the fixed point of T_k).

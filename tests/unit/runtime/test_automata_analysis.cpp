@@ -85,6 +85,18 @@ TEST_CASE("seed 002's C1 edge: λ and μ sub-dominant, half-tangents along the c
     CHECK(r.junctions[0].tangents == rt::JunctionAnalysis::Tangents::collinear);
 }
 
+TEST_CASE("a copy placed at the fixed point has no component on v2, one beside it has",
+          "[automata][analysis]") {
+    ir::Automaton a = c1_edge(q(7, 10), q(3, 5));
+    a.states.push_back(state("v", ir::Space::barycentric(1)));
+    a.arcs.push_back(arc(0, 1, Matrix<Rational>{{1}, {0}, {0}}, "at_x0")); // the fixed point of T0
+    a.arcs.push_back(arc(0, 1, Matrix<Rational>{{0}, {1}, {0}}, "beside"));
+    const rt::OperatorAnalysis t0 = rt::analyze(a).operators.at(0);
+    REQUIRE(t0.copies.size() == 2);
+    CHECK(t0.copies[0].along == rt::OperatorAnalysis::Copy::Along::no);
+    CHECK(t0.copies[1].along == rt::OperatorAnalysis::Copy::Along::yes);
+}
+
 TEST_CASE("seed 002's C1 edge: λ < (1 - μ)/2 loses the tangent continuity", "[automata][analysis]") {
     // λ = 1/10 < (1 - μ)/2 = 7/20 and μ = 3/10 < (1 - λ)/2 = 9/20: the sub-dominant eigenvalues are the
     // other ones, their eigenvectors leave the control polygon's edges, and the half-tangents at the
@@ -131,6 +143,31 @@ TEST_CASE("seed 004's junction: λ2 = 0.696, G1", "[automata][analysis]") {
     CHECK(l2.value_re.hi < 0.6965);
     CHECK(l2.value_re.hi - l2.value_re.lo < 1e-12);
     CHECK(ti.fixed.exact == Rational(1));
+}
+
+TEST_CASE("seed 004's junction: both copies reach the junction point along v2", "[automata][analysis]") {
+    // States i (the junction), l (cubic), r (quadratic): T^l and T^r place the copies whose control
+    // polygons have components on v2, so both half-tangents are along ±v2.
+    const std::vector<Rational> x{dec("0.131"), dec("0.2"),  dec("0.38"), dec("0.289"),
+                                  dec("0.11"),  dec("0.12"), dec("0.1"),  dec("0.12")};
+    ir::Automaton a = junction(x);
+    a.states.push_back(state("l", ir::Space::barycentric(4)));
+    a.states.push_back(state("r", ir::Space::barycentric(3)));
+    const Matrix<Rational> t = junction_operator(x);
+    Matrix<Rational> tl(5, 4), tr(5, 3);
+    for (std::size_t row = 0; row < 5; ++row) {
+        for (std::size_t c = 0; c < 3; ++c)
+            tl(row, c + 1) = t(row, c); // T^l's last 3 columns = T^i's first 3
+        for (std::size_t c = 0; c < 2; ++c) tr(row, c) = t(row, c + 3); // T^r's first 2 = T^i's last 2
+    }
+    tl(0, 0) = tl(1, 0) = q(1, 2);
+    tr(3, 2) = q(1, 4), tr(4, 2) = q(3, 4);
+    a.arcs.push_back(arc(0, 1, tl, "Tl"));
+    a.arcs.push_back(arc(0, 2, tr, "Tr"));
+    const rt::OperatorAnalysis ti = rt::analyze(a).operators.at(0);
+    REQUIRE(ti.copies.size() == 2);
+    CHECK(ti.copies[0].along == rt::OperatorAnalysis::Copy::Along::yes);
+    CHECK(ti.copies[1].along == rt::OperatorAnalysis::Copy::Along::yes);
 }
 
 TEST_CASE("seed 004's junction: a complex pair spirals, a negative λ2 oscillates", "[automata][analysis]") {
