@@ -214,18 +214,20 @@ int geometric_multiplicity(const Matrix<Rational>& t, const Rational& r) {
 
 // Marks a as the exact eigenvalue r of the polynomial p when p(r) = 0, with its multiplicity.
 void recognise(Eigenpair& e, const std::vector<Rational>& p, const Matrix<Rational>& t, bool fixed) {
-    if (e.is_complex()) return;
+    // A multiple root: the double approximation is only good to about sqrt(eps), and may even come as
+    // a complex pair with a tiny imaginary part.
+    const double tol = 1e-6 * std::max(1.0, std::abs(e.re));
+    if (e.is_complex() && (e.verified || std::abs(e.im) > tol)) return;
     std::optional<Rational> r;
     if (fixed)
         r = Rational(1);
     else if (e.verified)
         r = simple_rational_in(e.re, e.value_re.lo, e.value_re.hi);
-    else { // a multiple root: the double approximation is only good to about sqrt(eps)
-        const double tol = 1e-6 * std::max(1.0, std::abs(e.re));
+    else
         r = simple_rational_in(e.re, e.re - tol, e.re + tol);
-    }
     if (!r || !evaluate(p, *r).is_zero()) return;
     e.exact = *r;
+    e.im = 0;
     e.multiplicity = 0;
     for (std::vector<Rational> q = p; !q.empty() && evaluate(q, *r).is_zero(); q = derivative(q))
         ++e.multiplicity;
@@ -402,7 +404,7 @@ OperatorAnalysis analyze_operator(const ir::Automaton& a, std::size_t arc) {
     for (Eigen::Index i = 0; i < solver.eigenvalues().size(); ++i)
         if (std::abs(solver.eigenvalues()[i] - 1.0) < std::abs(solver.eigenvalues()[dominant] - 1.0))
             dominant = i;
-    if (op.exact) o.characteristic = characteristic_polynomial(*op.exact);
+    if (op.exact && n <= exact_spectrum_limit) o.characteristic = characteristic_polynomial(*op.exact);
     for (Eigen::Index i = 0; i < solver.eigenvalues().size(); ++i) {
         const std::complex<double> l = solver.eigenvalues()[i];
         if (l.imag() < 0) continue; // a complex pair once

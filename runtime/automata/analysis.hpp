@@ -97,6 +97,11 @@ struct AutomatonAnalysis {
     std::vector<JunctionAnalysis> junctions;
 };
 
+// The largest bary(n) whose exact operators also get the exact characteristic polynomial (its
+// Faddeev–LeVerrier cost grows as n^4 rational operations on growing numbers); larger ones are
+// analysed on their enclosures alone.
+inline constexpr std::size_t exact_spectrum_limit = 16;
+
 // Analyses every arc from a barycentric state to itself. Throws std::invalid_argument when the automaton
 // has none.
 AutomatonAnalysis analyze(const ir::Automaton& a);

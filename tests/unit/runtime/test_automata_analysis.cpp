@@ -274,3 +274,34 @@ TEST_CASE("eigenvalue enclosures contain the long double eigenvalues of random b
     // Random matrices have simple spectra: the test must separate nearly all of them.
     CHECK(separated >= trials * 9 / 10);
 }
+
+TEST_CASE("a double eigenvalue 1 has no unique fixed point", "[automata][analysis]") {
+    ir::Automaton a;
+    a.name = "split";
+    a.states.push_back(state("s", ir::Space::barycentric(3)));
+    a.arcs.push_back(arc(0, 0, Matrix<Rational>{{1, 0, q(1, 2)}, {0, 1, q(1, 2)}, {0, 0, 0}}, "T"));
+    const rt::OperatorAnalysis o = rt::analyze(a).operators.at(0);
+    CHECK(o.fixed.exact == Rational(1));
+    CHECK(o.fixed.multiplicity == 2);
+    CHECK(o.behaviour == rt::Behaviour::undecided);
+    CHECK_THAT(o.reason, Catch::Contains("no unique fixed point"));
+}
+
+TEST_CASE("operators beyond the exact limit are analysed on their enclosures", "[automata][analysis]") {
+    const std::size_t n = rt::exact_spectrum_limit + 4;
+    Matrix<Rational> t(n, n);
+    for (std::size_t c = 0; c < n; ++c) { // a lazy random walk: 1/2 stay, 1/2 one step down (cyclic)
+        t(c, c) = q(1, 2);
+        t((c + 1) % n, c) += q(1, 2) - q(1, static_cast<long>(4 * n));
+        t(0, c) += q(1, static_cast<long>(4 * n));
+    }
+    ir::Automaton a;
+    a.name = "walk";
+    a.states.push_back(state("s", ir::Space::barycentric(static_cast<int>(n))));
+    a.arcs.push_back(arc(0, 0, t, "T"));
+    const rt::OperatorAnalysis o = rt::analyze(a).operators.at(0);
+    CHECK_FALSE(o.characteristic);
+    CHECK(o.fixed.verified);
+    CHECK_FALSE(o.fixed.exact);
+    CHECK(o.separated);
+}
