@@ -286,7 +286,9 @@ void classify(OperatorAnalysis& o, std::size_t n) {
     const Interval m2 = l2.modulus();
     if (o.others.size() > 1) {
         const Interval m3 = o.others[1].modulus();
-        if (!(m2.lo > m3.hi)) {
+        double rest = 0; // the largest modulus after λ2 (sorted on the approximations, so all are checked)
+        for (std::size_t k = 1; k < o.others.size(); ++k) rest = std::max(rest, o.others[k].modulus().hi);
+        if (!(m2.lo > rest)) {
             o.reason = fmt::format("|λ2| = |{}| is not proven larger than |λ3| = |{}|", format_value(l2),
                                    format_value(o.others[1]));
             return;
@@ -491,6 +493,11 @@ std::optional<JunctionAnalysis> junction(const ir::Automaton& a, const std::vect
                 }
         out.tangents = JunctionAnalysis::Tangents::collinear;
         out.reason = "the half-tangents are collinear (exact): G1";
+        return out;
+    }
+    if (vp->vector_re.empty() || vq->vector_re.empty()) { // an exact Jordan eigenvector, an inexact piece
+        out.tangents = JunctionAnalysis::Tangents::undecided;
+        out.reason = "the half-tangents have no enclosure to compare";
         return out;
     }
     num::UpwardRounding up;
