@@ -191,9 +191,14 @@ int run_analyze(const std::string& file, const std::string& name) {
     for (const rt::OperatorAnalysis& o : result.operators) print_operator(a, o);
     for (const rt::JunctionAnalysis& j : result.junctions) {
         const auto& ops = result.operators;
-        std::cout << fmt::format("junction {}(x_{}) = {}(x_{}){} at {}: {}\n", ops[j.left].label,
+        std::string pname, through;
+        if (const ir::Operator* p = projection_of(a, ops[j.left].state, pname))
+            through =
+                fmt::format(" (through {}: {})", pname, approx_text(project(*p, midpoints(j.point), false)));
+        std::cout << fmt::format("junction {}(x_{}) = {}(x_{}){} at {}{}: {}\n", ops[j.left].label,
                                  ops[j.left_end].label, ops[j.right].label, ops[j.right_end].label,
-                                 j.meet_exact ? " exactly" : "", approx_text(midpoints(j.point)), j.reason);
+                                 j.meet_exact ? " exactly" : "", approx_text(midpoints(j.point)), through,
+                                 j.reason);
     }
     return 0;
 }
