@@ -133,12 +133,20 @@ void print_operator(const ir::Automaton& a, const rt::OperatorAnalysis& o) {
                                             pname));
         }
     }
-    if (o.c1_condition) {
+    if (o.edge) {
         const rt::Eigenpair& edge = o.others[*o.edge];
+        std::vector<std::string> v(a.arcs[o.arc].op.rows(), "0");
+        v[o.edge_from] = "-1";
+        v[o.edge_from + 1] = "1";
+        const std::string value = edge.exact ? edge.exact->to_string() : fmt::format("{:.6g}", edge.re);
+        const std::string rival = o.c1_exact_rival ? o.c1_exact_rival->to_string()
+                                                   : fmt::format("{:.6g}", num::midpoint(o.c1_rival));
+        const char* verdict = !o.c1_condition   ? "undecided (the enclosures overlap)"
+                              : *o.c1_condition ? "holds"
+                                                : "fails";
         std::cout << fmt::format(
             "  C1 condition at this vertex (seed 002): λ{} = {} of the polygon edge {} ≥ {}: {}\n",
-            *o.edge + 2, edge.exact->to_string(), exact_text(*edge.exact_vector), o.c1_rival->to_string(),
-            *o.c1_condition ? "holds" : "fails");
+            *o.edge + 2, value, vector_text(v), rival, verdict);
     }
     if (o.behaviour == rt::Behaviour::spiral) {
         const rt::Eigenpair& l2 = o.others.front();

@@ -321,28 +321,71 @@ void classify(OperatorAnalysis& o, std::size_t n) {
     }
 }
 
-// Whether v is an edge e_(j+1) - e_j of the control polygon, up to scale.
-bool is_polygon_edge(const std::vector<Rational>& v) {
-    std::vector<std::size_t> nonzero;
-    for (std::size_t k = 0; k < v.size(); ++k)
-        if (!v[k].is_zero()) nonzero.push_back(k);
-    return nonzero.size() == 2 && nonzero[1] == nonzero[0] + 1 && v[nonzero[0]] == -v[nonzero[1]];
-}
-
-void c1_condition(OperatorAnalysis& o) {
-    for (std::size_t k = 0; k < o.others.size(); ++k)
-        if (o.others[k].exact_vector && is_polygon_edge(*o.others[k].exact_vector)) o.edge = k;
+// Seed 002's C1 condition. e_(j+1) - e_j is an eigenvector of T exactly when columns j and j + 1 differ
+// only in rows j and j + 1 (columns summing to 1 make those two differences opposite); its eigenvalue is
+// then T(j+1, j+1) - T(j+1, j). Exact operators compare exactly; enclosures need the other rows' entries
+// thin and equal, and compare by intervals.
+void c1_condition(const ir::Operator& t, OperatorAnalysis& o) {
+    const std::size_t n = t.rows();
+    for (std::size_t j = 0; j + 1 < n && !o.edge; ++j) {
+        bool edge = true;
+        for (std::size_t r = 0; r < n && edge; ++r) {
+            if (r == j || r == j + 1) continue;
+            edge = t.exact ? (*t.exact)(r, j) == (*t.exact)(r, j + 1)
+                           : t.enclosure(r, j).is_thin() && t.enclosure(r, j) == t.enclosure(r, j + 1);
+        }
+        if (!edge) continue;
+        std::optional<Rational> exact;
+        Interval value;
+        if (t.exact) {
+            exact = (*t.exact)(j + 1, j + 1) - (*t.exact)(j + 1, j);
+            value = num::enclose(*exact);
+        } else {
+            num::UpwardRounding up;
+            value = num::sub(t.enclosure(j + 1, j + 1), t.enclosure(j + 1, j));
+        }
+        // The entry of the spectrum it is: equal, or the only real enclosure meeting it.
+        std::optional<std::size_t> match;
+        for (std::size_t k = 0; k < o.others.size(); ++k) {
+            const Eigenpair& e = o.others[k];
+            const bool same = exact && e.exact ? *exact == *e.exact
+                                               : !e.is_complex() && (e.verified || e.exact) &&
+                                                     !num::intersect(value, e.value_re).is_empty();
+            if (!same) continue;
+            if (match) return; // two candidates: no verdict
+            match = k;
+        }
+        if (!match) return;
+        o.edge = match;
+        o.edge_from = j;
+    }
     if (!o.edge) return;
-    Rational rival;
+    const Eigenpair& edge = o.others[*o.edge];
+    Interval rival(0.0); // [largest lower bound, largest upper bound] of the other moduli
     for (std::size_t k = 0; k < o.others.size(); ++k) {
         if (k == *o.edge) continue;
-        if (!o.others[k].exact) return; // an irrational rival: compared by the behaviour's enclosures only
-        rival = std::max(rival, abs(*o.others[k].exact));
+        const Interval m = o.others[k].modulus();
+        rival = Interval(std::max(rival.lo, m.lo), std::max(rival.hi, m.hi));
     }
-    const Rational& lambda = *o.others[*o.edge].exact;
-    if (o.others[*o.edge].multiplicity > 1) rival = std::max(rival, abs(lambda)); // its own second copy
+    if (edge.multiplicity > 1) { // its own second copy
+        const Interval m = edge.modulus();
+        rival = Interval(std::max(rival.lo, m.lo), std::max(rival.hi, m.hi));
+    }
     o.c1_rival = rival;
-    o.c1_condition = lambda.sign() > 0 && lambda >= rival;
+    if (edge.exact &&
+        std::all_of(o.others.begin(), o.others.end(), [](const Eigenpair& e) { return e.exact; })) {
+        Rational largest;
+        for (std::size_t k = 0; k < o.others.size(); ++k)
+            if (k != *o.edge || edge.multiplicity > 1) largest = std::max(largest, abs(*o.others[k].exact));
+        o.c1_exact_rival = largest;
+        o.c1_condition = edge.exact->sign() > 0 && *edge.exact >= largest;
+        return;
+    }
+    const Interval lambda = edge.value_re;
+    if (lambda.lo > 0 && lambda.lo >= rival.hi)
+        o.c1_condition = true;
+    else if (lambda.hi <= 0 || lambda.hi < rival.lo)
+        o.c1_condition = false;
 }
 
 // The copies' components on v2 (see OperatorAnalysis::Copy): exactly when λ2 and the operators are
@@ -429,7 +472,7 @@ OperatorAnalysis analyze_operator(const ir::Automaton& a, std::size_t arc) {
         return std::abs(std::complex(x.re, x.im)) > std::abs(std::complex(y.re, y.im));
     });
     classify(o, n);
-    c1_condition(o);
+    c1_condition(op, o);
     if (o.behaviour == Behaviour::tangent) copies_along_v2(a, o);
     return o;
 }

@@ -63,12 +63,15 @@ struct OperatorAnalysis {
     bool separated = false;
     Behaviour behaviour = Behaviour::undecided;
     std::string reason; // what decided the behaviour, with the numbers
-    // Seed 002's C1 condition at a vertex: the eigenvalue whose eigenvector is an edge of the control
-    // polygon (e_(j+1) - e_j, exactly) is real, positive and at least the modulus of every other
-    // sub-dominant eigenvalue (λ ≥ (1 - μ)/2 for its C1 edge). Exact operators only.
+    // Seed 002's C1 condition at a vertex: the eigenvalue whose eigenvector is an edge e_(j+1) - e_j of
+    // the control polygon is real, positive and at least the modulus of every other sub-dominant
+    // eigenvalue (λ ≥ (1 - μ)/2 for its C1 edge). Unset when no such eigenvector is proven, or when the
+    // enclosures do not decide.
     std::optional<std::size_t> edge; // index into `others`
+    std::size_t edge_from = 0;       // j
     std::optional<bool> c1_condition;
-    std::optional<num::Rational> c1_rival; // the largest other modulus it is compared with (0: none)
+    num::Interval c1_rival;                      // the largest other modulus (0: none), enclosed
+    std::optional<num::Rational> c1_exact_rival; // the same, exactly, when every eigenvalue is exact
     // Seed 004, sec. 4: the arcs from this state to others place copies of their curves, whose control
     // polygons are the arcs' columns; a copy approaches the fixed point along v2 when a column has a
     // non-zero component w2^T p on v2 (w2: the left eigenvector). Analysed for a half-tangent only.

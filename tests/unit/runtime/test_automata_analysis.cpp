@@ -76,9 +76,9 @@ TEST_CASE("seed 002's C1 edge: λ and μ sub-dominant, half-tangents along the c
     CHECK(t0.behaviour == rt::Behaviour::tangent);
     CHECK(t1.behaviour == rt::Behaviour::tangent);
     CHECK(t0.c1_condition == true); // λ = 7/10 ≥ (1 - μ)/2 = 1/5
-    CHECK(t0.c1_rival == q(1, 5));
+    CHECK(t0.c1_exact_rival == q(1, 5));
     CHECK(t1.c1_condition == true); // μ = 3/5 ≥ (1 - λ)/2 = 3/20
-    CHECK(t1.c1_rival == q(3, 20));
+    CHECK(t1.c1_exact_rival == q(3, 20));
     // The pieces T0(A) and T1(A) meet at T0 x1 = T1 x0 with collinear half-tangents.
     REQUIRE(r.junctions.size() == 1);
     CHECK(r.junctions[0].meet_exact);
@@ -97,6 +97,41 @@ TEST_CASE("a copy placed at the fixed point has no component on v2, one beside i
     CHECK(t0.copies[1].along == rt::OperatorAnalysis::Copy::Along::yes);
 }
 
+TEST_CASE("seed 002's C1 condition on interval operators (irrational λ, μ)", "[automata][analysis]") {
+    // λ = sqrt(2)/2, μ = 1/pi on both sides of the condition, as enclosures (entries of width > 0).
+    const auto edge = [](double lambda, double mu) {
+        num::UpwardRounding up;
+        const Interval l =
+            lambda > 0.5 ? num::div(num::sqrt(Interval(2)), Interval(2)) : num::div(Interval(1), num::pi());
+        const Interval m =
+            mu > 0.5 ? num::div(num::sqrt(Interval(2)), Interval(2)) : num::div(Interval(1), num::pi());
+        const Interval one(1), half(0.5);
+        const Matrix<Interval> t0{{one, num::sub(one, l), num::mul(half, num::sub(one, l))},
+                                  {0, l, num::mul(half, num::add(l, m))},
+                                  {0, 0, num::mul(half, num::sub(one, m))}};
+        const Matrix<Interval> t1{{num::mul(half, num::sub(one, l)), 0, 0},
+                                  {num::mul(half, num::add(l, m)), m, 0},
+                                  {num::mul(half, num::sub(one, m)), num::sub(one, m), one}};
+        ir::Automaton a;
+        a.name = "c1_edge";
+        a.states.push_back(state("e", ir::Space::barycentric(3)));
+        a.arcs.push_back(arc(0, 0, t0, "T0"));
+        a.arcs.push_back(arc(0, 0, t1, "T1"));
+        return rt::analyze(a);
+    };
+    // λ = 0.707 ≥ (1 - μ)/2 = 0.341 and μ = 0.318 ≥ (1 - λ)/2 = 0.146: both hold.
+    const rt::AutomatonAnalysis good = edge(0.7, 0.3);
+    REQUIRE(good.operators[0].edge);
+    CHECK(good.operators[0].edge_from == 0);
+    CHECK(good.operators[0].c1_condition == true);
+    CHECK(good.operators[1].edge_from == 1);
+    CHECK(good.operators[1].c1_condition == true);
+    // λ = μ = 1/pi = 0.318 < (1 - μ)/2 = (1 - λ)/2 = 0.341: fails on both sides.
+    const rt::AutomatonAnalysis bad = edge(0.3, 0.3);
+    CHECK(bad.operators[0].c1_condition == false);
+    CHECK(bad.operators[1].c1_condition == false);
+}
+
 TEST_CASE("seed 002's C1 edge: λ < (1 - μ)/2 loses the tangent continuity", "[automata][analysis]") {
     // λ = 1/10 < (1 - μ)/2 = 7/20 and μ = 3/10 < (1 - λ)/2 = 9/20: the sub-dominant eigenvalues are the
     // other ones, their eigenvectors leave the control polygon's edges, and the half-tangents at the
@@ -108,7 +143,7 @@ TEST_CASE("seed 002's C1 edge: λ < (1 - μ)/2 loses the tangent continuity", "[
     CHECK(t1.others[0].exact == q(9, 20));
     CHECK(t0.others[0].exact_vector != exact({-1, 1, 0}));
     CHECK(t0.c1_condition == false); // λ = 1/10 < (1 - μ)/2 = 7/20
-    CHECK(t0.c1_rival == q(7, 20));
+    CHECK(t0.c1_exact_rival == q(7, 20));
     CHECK(t1.c1_condition == false); // μ = 3/10 < (1 - λ)/2 = 9/20
     REQUIRE(r.junctions.size() == 1);
     CHECK(r.junctions[0].tangents == rt::JunctionAnalysis::Tangents::not_collinear);
@@ -126,7 +161,7 @@ TEST_CASE("seed 002's C1 edge on the boundary λ = (1 - μ)/2: a double eigenval
     // holds with equality.
     CHECK(t0.behaviour == rt::Behaviour::tangent);
     CHECK(t0.c1_condition == true);
-    CHECK(t0.c1_rival == q(1, 5));
+    CHECK(t0.c1_exact_rival == q(1, 5));
 }
 
 TEST_CASE("seed 004's junction: λ2 = 0.696, G1", "[automata][analysis]") {
@@ -175,6 +210,7 @@ TEST_CASE("seed 004's junction: a complex pair spirals, a negative λ2 oscillate
         rt::analyze(junction({0, 0, dec("0.1"), dec("0.8"), dec("0.4"), dec("0.2"), 0, dec("0.15")}))
             .operators.at(0);
     CHECK(spiral.behaviour == rt::Behaviour::spiral);
+    CHECK_FALSE(spiral.edge); // no eigenvector along an edge of the control polygon
     CHECK(spiral.others.at(0).value_im.lo > 0.48);
     CHECK(spiral.others.at(0).value_re.hi < 0.17);
     const rt::OperatorAnalysis oscillation = rt::analyze(junction({0, dec("0.1"), 0, dec("0.9"), dec("0.15"),
