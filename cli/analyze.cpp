@@ -29,6 +29,7 @@ std::string exact_text(const std::vector<Rational>& v) {
     return vector_text(s);
 }
 
+// Six digits; rounding noise around 0 (the midpoint of an enclosure of 0) is printed as 0.
 std::string approx_text(const std::vector<double>& v) {
     std::vector<std::string> s;
     for (double x : v) s.push_back(fmt::format("{:.6g}", std::abs(x) < 5e-13 ? 0.0 : x));
