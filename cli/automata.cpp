@@ -90,6 +90,24 @@ int run_tree(const std::string& file, const TreeOptions& o) {
     return 0;
 }
 
+int run_solve(const std::string& file, const std::string& name) {
+    auto c = compile_or_report(file);
+    if (!c) return front::exit_compile_error;
+    bool any = false;
+    for (const front::AutomatonInfo& a : c->module.automata) {
+        if (a.solution.empty() || (!name.empty() && a.name != name)) continue;
+        std::cout << a.solution;
+        any = true;
+    }
+    if (!any && !name.empty()) {
+        const front::AutomatonInfo& a = find_automaton(*c, name);
+        throw UsageError(
+            fmt::format("'{}' is an ifs or cifs, not a bcifs: it has no constraints to solve", a.name));
+    }
+    if (!any) throw UsageError(fmt::format("{} has no bcifs", file));
+    return 0;
+}
+
 int run_chaos(const std::string& file, const ChaosCommandOptions& o) {
     check_picture_output(o.output, false);
     if (o.points < 1 || o.points > 4'000'000'000ULL) throw UsageError("-n must be between 1 and 4e9 points");

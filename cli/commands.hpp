@@ -48,6 +48,8 @@ struct TreeOptions {
 };
 // frac tree FILE NAME --depth n [-o FILE.png|FILE.svg]: the evaluation tree, one colour per state.
 int run_tree(const std::string& file, const TreeOptions& options);
+// frac solve: every bcifs's operators with exact entries and named free parameters (or only `name`'s).
+int run_solve(const std::string& file, const std::string& name);
 struct ChaosCommandOptions {
     std::string name, output;
     std::uint64_t points = 1'000'000, seed = 1;

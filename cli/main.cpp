@@ -181,6 +181,12 @@ int run(int argc, char** argv) {
     tree->add_option("--emit", tree_emit, "tree: print the text dump (the default without -o)")
         ->check(CLI::IsMember({"tree"}));
 
+    std::string solve_name;
+    auto* solve = app.add_subcommand(
+        "solve", "solve the constraints of a bcifs: its operators with exact entries and free parameters");
+    solve->add_option("file", file, "model file")->required();
+    solve->add_option("name", solve_name, "bcifs name (default: every bcifs of the file)");
+
     cli::ChaosCommandOptions chaos_options;
     auto* chaos = app.add_subcommand("chaos", "the chaos game of an ifs or cifs, as a density picture");
     chaos->add_option("file", file, "model file")->required();
@@ -291,6 +297,7 @@ int run(int argc, char** argv) {
         }
         if (*chaos) return cli::run_chaos(file, chaos_options);
         if (*analyze) return cli::run_analyze(file, analyze_name);
+        if (*solve) return cli::run_solve(file, solve_name);
         if (*mesh) return cli::run_mesh(file, mesh_options, engine);
         if (*test) return cli::run_tests(files, false, engine);
         if (*compile) return cli::run_compile(file, compile_options);

@@ -7,6 +7,7 @@
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/jit.hpp"
 #include "frontend/resolve.hpp"
+#include "frontend/topology.hpp"
 #include "ir/specialize.hpp"
 #include "ir/tape.hpp"
 
@@ -20,6 +21,8 @@ const std::vector<StageInfo>& stages() {
     static const std::vector<StageInfo> table = {
         {Stage::lex, "lex", "the tokens of the main file"},
         {Stage::parse, "parse", "the syntax tree of the main file (imports read and parsed)"},
+        {Stage::constraints, "constraints",
+         "each bcifs's operators and constraints, with those its topology declarations generate"},
         {Stage::resolve, "resolve", "the definitions every name resolves to"},
         {Stage::typecheck, "typecheck", "the type of every definition and function instance"},
         {Stage::const_eval, "consteval",
@@ -77,6 +80,8 @@ auto timed(PassTimes* times, const std::string& name, F&& run) {
 // The stages after loading, up to options.stop.
 void run_frontend(front::Compilation& c, const CompileOptions& options) {
     const auto reached = [&](Stage s) { return options.stop < s || c.diags.has_errors(); };
+    if (reached(Stage::constraints)) return;
+    timed(options.times, stage_name(Stage::constraints), [&] { front::expand_topology(c.program, c.diags); });
     if (reached(Stage::resolve)) return;
     timed(options.times, stage_name(Stage::resolve), [&] { front::resolve_names(c.program, c.diags); });
     if (reached(Stage::typecheck)) return;
@@ -210,6 +215,7 @@ std::string emit(const front::Compilation& c, Stage stage, const std::vector<std
         return out;
     }
     case Stage::parse: return front::print_ast(c.program, main_file);
+    case Stage::constraints: return front::print_constraints(c.program, main_file);
     case Stage::resolve: return definitions_text(c);
     case Stage::typecheck: return front::print_types(c.program, c.typed, main_file);
     case Stage::const_eval: return front::print_constants(c.program, c.constants, main_file);

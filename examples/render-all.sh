@@ -52,6 +52,10 @@ automaton penrose chaos "" png
 for j in junction_g1 junction_spiral junction_oscillation; do
     "$frac" render "$here/differential.frac" "$j" --method tree --depth 10 -o "$out/$j.svg"
 done
+# Boundary controlled IFS (examples/bcifs.frac): constraints solved by the compiler, drawn by the chaos game.
+for name in fractal_edge spiky_edge c1_edge quad_patch; do
+    "$frac" render "$here/bcifs.frac" "$name" --method chaos --size 512 -o "$out/bcifs_$name.png"
+done
 echo
 echo "pictures (left: recursive subdivision process, right: cover) and meshes are in $out:"
 ls -1 "$out" | sed "s|^|  $out/|"

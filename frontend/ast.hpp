@@ -91,14 +91,83 @@ struct ArcDecl {
     ExprPtr probability; // or null
 };
 
+// A BCIFS (seed 002 sec. 3): cells are the states; each cell has subdivision operators (arcs of the
+// automaton: A_c is the union of T(A_target)) and boundary operators B : X^from -> X^c that embed a
+// lower cell, which are no arcs. Operators may be unknown (`?`, or a matrix with `?` entries); the
+// constraints (products of operators, equal) and `fix` statements determine them, solved exactly.
+struct OperatorDecl {
+    std::string cell, name, target; // subdivision: cell -> target; boundary: the cell it embeds
+    bool boundary = false;
+    Location loc, target_loc;
+    ExprPtr value; // null: unknown; a matrix whose entries may be unknown (is_unknown); or an expression
+    bool generated = false; // by a topology declaration
+};
+
+// One factor of a constraint's product: an operator `cell.name`, or a constant matrix.
+struct FactorDecl {
+    std::string cell, name; // empty for a constant
+    ExprPtr constant;
+    Location loc;
+};
+
+struct ConstraintDecl {
+    std::vector<FactorDecl> left, right;
+    Location loc;
+    std::string origin; // empty when written; else the topology declaration that generated it
+};
+
+// fix cell.name[row][col] = value;
+struct FixDecl {
+    std::string cell, name;
+    int row = 0, col = 0;
+    ExprPtr value;
+    Location loc, index_loc;
+};
+
+// param name [in [lo, hi]] [= value];  a symbolic parameter of the solution (seed 002's λ, μ).
+struct ParamDecl {
+    std::string name;
+    Location loc;
+    ExprPtr lo, hi, value; // each may be null
+};
+
+// topology e = edge(v) split n;  topology f = quad(e) split n x n;  (frontend/topology.hpp)
+struct TopologyDecl {
+    std::string cell, kind, of; // kind: edge or quad; `of`: the boundary cell
+    int n = 2, m = 1;
+    Location loc, kind_loc, of_loc;
+};
+
+struct BcifsDecl {
+    std::vector<TopologyDecl> topologies;
+    std::vector<OperatorDecl> operators;
+    std::vector<ConstraintDecl> constraints;
+    std::vector<FixDecl> fixes;
+    std::vector<ParamDecl> params;
+};
+
+// An unknown entry `?` of an operator's matrix.
+inline bool is_unknown(const Expr& e) {
+    return e.kind == ExprKind::name && e.text == "?";
+}
+
 struct AutomatonDecl {
-    bool graph_directed = false; // cifs; an ifs has one state, named as the automaton
+    bool graph_directed = false;      // cifs or bcifs; an ifs has one state, named as the automaton
+    std::shared_ptr<BcifsDecl> bcifs; // a bcifs: its states are the cells
     std::vector<StateDecl> states;
     std::vector<ArcDecl> arcs;
     std::string initial; // empty: the first state
     Location initial_loc;
     ExprPtr projection; // project = controls(...): for a barycentric initial state, or null
 };
+
+// The initial state: the one named `initial`, else the first state (ifs, cifs) or the last cell (a bcifs,
+// whose cells are declared from the lowest up).
+inline const StateDecl& initial_state(const AutomatonDecl& a) {
+    for (const StateDecl& s : a.states)
+        if (s.name == a.initial) return s;
+    return a.bcifs ? a.states.back() : a.states.front();
+}
 
 struct Item {
     ItemKind kind;
@@ -124,5 +193,7 @@ Program parse(const std::vector<Token>& tokens, Diagnostics& diags);
 // Only the items of `file` when it is not 0 (imported files' items are left out).
 std::string print_ast(const Program& p, std::uint32_t file = 0);
 std::string print_expr(const Expr& e);
+// A constraint's side as written: e.B0 * v.T0 (a constant factor in its syntax-tree form).
+std::string print_product(const std::vector<FactorDecl>& side);
 
 } // namespace frac::front

@@ -31,7 +31,37 @@ const char* op_text(Tok op) {
     }
 }
 
+std::string print_factors(const std::vector<FactorDecl>& side) {
+    std::vector<std::string> out;
+    for (const FactorDecl& f : side)
+        out.push_back(f.constant ? print_expr(*f.constant) : f.cell + "." + f.name);
+    return fmt::format("({})", fmt::join(out, " "));
+}
+
+std::string print_bcifs(const BcifsDecl& b) {
+    std::string out;
+    for (const ParamDecl& p : b.params)
+        out += fmt::format("\n  (param {}{}{})", p.name,
+                           p.lo ? fmt::format(" (in {} {})", print_expr(*p.lo), print_expr(*p.hi)) : "",
+                           p.value ? " " + print_expr(*p.value) : "");
+    for (const OperatorDecl& op : b.operators)
+        out += fmt::format("\n  ({} {}.{} {} {})", op.boundary ? "boundary" : "subdivide", op.cell, op.name,
+                           op.target, op.value ? print_expr(*op.value) : "?");
+    for (const ConstraintDecl& c : b.constraints)
+        out += fmt::format("\n  (== {} {})", print_factors(c.left), print_factors(c.right));
+    for (const FixDecl& f : b.fixes)
+        out += fmt::format("\n  (fix {}.{} {} {} {})", f.cell, f.name, f.row, f.col, print_expr(*f.value));
+    return out;
+}
+
 } // namespace
+
+std::string print_product(const std::vector<FactorDecl>& side) {
+    std::vector<std::string> out;
+    for (const FactorDecl& f : side)
+        out.push_back(f.constant ? print_expr(*f.constant) : f.cell + "." + f.name);
+    return fmt::format("{}", fmt::join(out, " * "));
+}
 
 std::string print_expr(const Expr& e) {
     auto kids = [&](std::size_t from = 0) {
@@ -104,7 +134,7 @@ std::string print_ast(const Program& p, std::uint32_t file) {
         case ItemKind::print: out += fmt::format("(print {})\n", print_expr(*it.body)); break;
         case ItemKind::automaton: {
             const AutomatonDecl& a = *it.automaton;
-            out += fmt::format("({} {}", a.graph_directed ? "cifs" : "ifs", it.name);
+            out += fmt::format("({} {}", a.bcifs ? "bcifs" : a.graph_directed ? "cifs" : "ifs", it.name);
             for (const StateDecl& s : a.states)
                 out += fmt::format("\n  (state {} {}{}{})", s.name, s.space.barycentric ? "bary" : "R",
                                    s.space.n,
@@ -113,6 +143,7 @@ std::string print_ast(const Program& p, std::uint32_t file) {
                 out += fmt::format("\n  (arc {} {}{} {}{})", arc.from, arc.to,
                                    arc.label.empty() ? "" : " " + arc.label, print_expr(*arc.op),
                                    arc.probability ? " (prob " + print_expr(*arc.probability) + ")" : "");
+            if (a.bcifs) out += print_bcifs(*a.bcifs);
             if (!a.initial.empty()) out += fmt::format("\n  (initial {})", a.initial);
             if (a.projection) out += fmt::format("\n  (project {})", print_expr(*a.projection));
             out += ")\n";

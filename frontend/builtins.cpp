@@ -31,6 +31,8 @@ constexpr Builtin builtins[] = {
     {"controls", BuiltinKind::controls, 2, 16, Op::Const},
     {"tabulate", BuiltinKind::tabulate, 2, 2, Op::Const},
     {"dist", BuiltinKind::distance, 2, 2, Op::External},
+    {"dof", BuiltinKind::dof, 1, 1, Op::Const},
+    {"kron", BuiltinKind::kron, 2, 2, Op::Const},
     {"point", BuiltinKind::primitive, 1, 1, Op::Const},
     {"segment", BuiltinKind::primitive, 2, 2, Op::Const},
     {"polyline", BuiltinKind::primitive, 0, 64, Op::Const},

@@ -19,9 +19,11 @@ enum class BuiltinKind {
     dimension, // dimension(shape, from: a, to: b [, split: s]), dimension(automaton) (tests and print only)
     transform, // translate, rotate, scale, shear: an affine map of R2 or R3 (constant arguments)
     controls,  // controls(P0, ..., Pn-1): the projection of bary(n) by control points
+    kron,      // kron(A, B): the Kronecker product of two matrices (tensor-product surfaces)
     primitive, // point, segment, polyline, polygon: what a state of an automaton draws
     tabulate,  // tabulate(automaton, t): the point F(t) of its address map, t = i / N^p (tests, print)
     distance,  // dist(p, automaton): the distance from the point p to the attractor (an external function)
+    dof,       // dof(bcifs.cell): the free entries a cell's operators keep after the constraints (tests)
 };
 
 struct Builtin {

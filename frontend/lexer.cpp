@@ -55,6 +55,7 @@ const char* token_name(Tok t) {
     case Tok::amp: return "'&'";
     case Tok::bar: return "'|'";
     case Tok::tilde: return "'~'";
+    case Tok::question: return "'?'";
     case Tok::times: return "'×'";
     case Tok::error: return "invalid token";
     }
@@ -183,13 +184,13 @@ private:
             Tok kind;
         };
         static const Punct puncts[] = {
-            {"..", Tok::dotdot},   {"==", Tok::eq},    {"!=", Tok::ne},    {"<=", Tok::le},
-            {">=", Tok::ge},       {"(", Tok::lparen}, {")", Tok::rparen}, {"[", Tok::lbracket},
-            {"]", Tok::rbracket},  {"{", Tok::lbrace}, {"}", Tok::rbrace}, {",", Tok::comma},
-            {";", Tok::semicolon}, {":", Tok::colon},  {".", Tok::dot},    {"=", Tok::assign},
-            {"<", Tok::lt},        {">", Tok::gt},     {"+", Tok::plus},   {"-", Tok::minus},
-            {"*", Tok::star},      {"/", Tok::slash},  {"^", Tok::caret},  {"&", Tok::amp},
-            {"|", Tok::bar},       {"~", Tok::tilde}};
+            {"..", Tok::dotdot},   {"==", Tok::eq},    {"!=", Tok::ne},     {"<=", Tok::le},
+            {">=", Tok::ge},       {"(", Tok::lparen}, {")", Tok::rparen},  {"[", Tok::lbracket},
+            {"]", Tok::rbracket},  {"{", Tok::lbrace}, {"}", Tok::rbrace},  {",", Tok::comma},
+            {";", Tok::semicolon}, {":", Tok::colon},  {".", Tok::dot},     {"=", Tok::assign},
+            {"<", Tok::lt},        {">", Tok::gt},     {"+", Tok::plus},    {"-", Tok::minus},
+            {"*", Tok::star},      {"/", Tok::slash},  {"^", Tok::caret},   {"&", Tok::amp},
+            {"|", Tok::bar},       {"~", Tok::tilde},  {"?", Tok::question}};
         for (const Punct& p : puncts) {
             const std::string_view text(p.text);
             if (s_.compare(pos_, text.size(), text) == 0) {

@@ -58,6 +58,7 @@ enum class Tok {
     amp,
     bar,
     tilde,
+    question, // ? (an unknown entry of a BCIFS operator)
     times,
     error
 };

@@ -1,5 +1,6 @@
 #include "frontend/lower.hpp"
 
+#include "frontend/bcifs.hpp"
 #include "frontend/builtins.hpp"
 #include "frontend/consteval.hpp"
 #include "frontend/inliner.hpp"
@@ -10,8 +11,11 @@
 #include "ir/automaton_check.hpp"
 #include "numeric/rational.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <unordered_map>
@@ -521,6 +525,10 @@ private:
         case BuiltinKind::primitive: break; // only after `primitive` (automaton_info)
         case BuiltinKind::tabulate: return tabulate(e);
         case BuiltinKind::distance: return distance(e);
+        case BuiltinKind::dof: return dof(e);
+        case BuiltinKind::kron:
+            return linear_value(LinearValue::matrix(
+                kronecker(expr(*e.args[0].value).linear->in(0), expr(*e.args[1].value).linear->in(0))));
         }
         throw InternalError("unknown builtin kind");
     }
@@ -548,6 +556,20 @@ private:
         NodeId c[3];
         for (std::size_t i = 0; i < 3; ++i) c[i] = i < pv.nodes.size() ? pv.nodes[i] : g_.constant(0.0);
         return Value::scalar(g_.external(static_cast<std::int64_t>(k), c[0], c[1], c[2]));
+    }
+
+    // dof(A.cell): a number known once A's constraints are solved (the type checker checked the form).
+    Value dof(const Expr& e) {
+        const Expr& a = *e.args[0].value;
+        const Item* it = globals_.at(a.kids[0]->text);
+        const auto index = automaton_index_.find(it);
+        if (index == automaton_index_.end())
+            fail(e.loc, fmt::format("'{}' did not compile, so its degrees of freedom are unknown", it->name));
+        const AutomatonInfo& info = m_.automata[index->second];
+        for (std::size_t s = 0; s < info.automaton.states.size(); ++s)
+            if (info.automaton.states[s].name == a.text)
+                return Value::scalar(g_.constant(num::Rational(info.dof[s])));
+        throw InternalError("dof: an unchecked cell");
     }
 
     // tabulate(A, t): F(t) at t = i / N^p, N the arcs per state, read as p digits (seed 003, sec. 2).
@@ -676,10 +698,12 @@ private:
 
     // The checks that need the operators' values (ir/automaton_check.hpp): barycentric columns summing
     // to 1, probabilities, dead ends, unreachable states (a warning), and a proof of contraction.
-    void check(AutomatonInfo& info) {
+    void check(AutomatonInfo& info, bool cells = false) {
         ir::ContractivityResult proof;
         bool failed = false;
         for (const ir::AutomatonProblem& p : ir::check_automaton(info.automaton, {}, &proof)) {
+            // A bcifs reaches its lower cells through boundary operators, which are no arcs.
+            if (cells && p.kind == ir::AutomatonProblem::Kind::unreachable) continue;
             const Location loc = p.arc     ? info.arc_locs.at(*p.arc)
                                  : p.state ? info.state_locs.at(*p.state)
                                            : info.loc;
@@ -694,6 +718,222 @@ private:
         }
         if (failed) throw AlreadyReported{};
         info.contraction = proof.message;
+    }
+
+    // ---- bcifs ----
+    static bool mentions(const Expr& e, const std::vector<std::string>& names) {
+        if (e.kind == ExprKind::name && std::find(names.begin(), names.end(), e.text) != names.end())
+            return true;
+        for (const ExprPtr& k : e.kids)
+            if (k && mentions(*k, names)) return true;
+        for (const Arg& a : e.args)
+            if (a.value && mentions(*a.value, names)) return true;
+        for (const Binding& b : e.bindings)
+            if (b.value && mentions(*b.value, names)) return true;
+        return false;
+    }
+
+    num::Rational exact_entry(const Expr& e) {
+        const Entry x = entry(closed(e, Context::constant), e.loc);
+        if (!x.exact)
+            fail(e.loc, "the entries of a bcifs are exact numbers (integers, decimals, fractions), since its "
+                        "constraints are solved exactly; this one is not");
+        return *x.exact;
+    }
+
+    // An entry as an affine form over the parameters (variable k is params[k]).
+    num::AffineForm affine_entry(const Expr& e, const std::vector<std::string>& params) {
+        num::AffineForm f;
+        if (!mentions(e, params)) {
+            f.constant = exact_entry(e);
+            return f;
+        }
+        if (e.kind == ExprKind::name)
+            return num::AffineForm::variable(
+                static_cast<std::size_t>(std::find(params.begin(), params.end(), e.text) - params.begin()));
+        if (e.kind == ExprKind::unary && (e.op == Tok::minus || e.op == Tok::plus))
+            return affine_entry(*e.kids[0], params) * num::Rational(e.op == Tok::minus ? -1 : 1);
+        if (e.kind == ExprKind::binary) {
+            const num::AffineForm a = affine_entry(*e.kids[0], params), b = affine_entry(*e.kids[1], params);
+            if (e.op == Tok::plus) return a + b;
+            if (e.op == Tok::minus) return a - b;
+            if (e.op == Tok::star && a.is_constant()) return b * a.constant;
+            if (e.op == Tok::star && b.is_constant()) return a * b.constant;
+            if (e.op == Tok::slash && b.is_constant() && !b.constant.is_zero())
+                return a * (num::Rational(1) / b.constant);
+        }
+        fail(e.loc, "an entry is affine in the parameters: sums of parameters times numbers");
+    }
+
+    // The constraint system of a bcifs, from its declaration (the type checker checked every size).
+    BcifsSystem bcifs_system(const Item& it, const std::function<std::size_t(const std::string&)>& index) {
+        const AutomatonDecl& decl = *it.automaton;
+        const BcifsDecl& b = *decl.bcifs;
+        BcifsSystem sys;
+        sys.name = it.name;
+        for (const ParamDecl& p : b.params) sys.params.push_back(p.name);
+        for (const StateDecl& s : decl.states) {
+            sys.cells.push_back(s.name);
+            sys.cell_order.push_back(space_of(s.space).coordinates());
+        }
+        std::map<std::pair<std::string, std::string>, std::size_t> op_index;
+        for (const OperatorDecl& d : b.operators) {
+            BcifsSystem::Operator o;
+            o.cell = d.cell;
+            o.name = d.name;
+            o.loc = d.loc;
+            o.cell_index = index(d.cell);
+            const ir::Space from = space_of(decl.states[o.cell_index].space),
+                            to = space_of(decl.states[index(d.target)].space);
+            o.rows = static_cast<std::size_t>(from.coordinates());
+            o.cols = static_cast<std::size_t>(to.coordinates());
+            o.barycentric =
+                from.kind == ir::Space::Kind::barycentric && to.kind == ir::Space::Kind::barycentric;
+            o.entries.assign(o.rows * o.cols, std::nullopt);
+            if (d.value && d.value->kind == ExprKind::matrix) {
+                for (std::size_t r = 0; r < o.rows; ++r)
+                    for (std::size_t c = 0; c < o.cols; ++c) {
+                        const Expr& x = *d.value->kids[r]->kids[c];
+                        if (!is_unknown(x)) o.entries[r * o.cols + c] = affine_entry(x, sys.params);
+                    }
+            } else if (d.value) {
+                const ir::Operator m = closed(*d.value, Context::constant).linear->in(0);
+                if (!m.exact)
+                    fail(d.value->loc,
+                         "the entries of a bcifs are exact numbers, since its constraints are solved "
+                         "exactly; this operator is not");
+                for (std::size_t r = 0; r < o.rows; ++r)
+                    for (std::size_t c = 0; c < o.cols; ++c) {
+                        num::AffineForm f;
+                        f.constant = (*m.exact)(r, c);
+                        o.entries[r * o.cols + c] = f;
+                    }
+            }
+            op_index[{d.cell, d.name}] = sys.operators.size();
+            sys.operators.push_back(std::move(o));
+        }
+        for (const ConstraintDecl& c : b.constraints) {
+            BcifsSystem::Constraint k;
+            k.loc = c.loc;
+            k.text = print_product(c.left) + " == " + print_product(c.right);
+            for (int s = 0; s < 2; ++s)
+                for (const FactorDecl& f : s == 0 ? c.left : c.right) {
+                    BcifsSystem::Factor x;
+                    if (f.constant) {
+                        const ir::Operator m = closed(*f.constant, Context::constant).linear->in(0);
+                        if (!m.exact)
+                            fail(f.loc, "a constraint's constant factor is a matrix of exact numbers");
+                        x.constant = *m.exact;
+                    } else {
+                        x.op = op_index.at({f.cell, f.name});
+                    }
+                    (s == 0 ? k.left : k.right).push_back(std::move(x));
+                }
+            sys.constraints.push_back(std::move(k));
+        }
+        for (const FixDecl& f : b.fixes) {
+            BcifsSystem::Fix x;
+            x.op = op_index.at({f.cell, f.name});
+            x.row = static_cast<std::size_t>(f.row);
+            x.col = static_cast<std::size_t>(f.col);
+            x.value = affine_entry(*f.value, sys.params);
+            x.loc = f.loc;
+            sys.fixes.push_back(std::move(x));
+        }
+        return sys;
+    }
+
+    // Solves the constraints, then gives the free entries and parameters values: a parameter its own,
+    // or the middle of its range; the free entries the most uniform operators (bcifs.hpp), then, while
+    // the compiler cannot prove the system contractive, those values moved by small steps drawn from a
+    // fixed seed (the same on every machine).
+    void bcifs_info(const Item& it, AutomatonInfo& info,
+                    const std::function<std::size_t(const std::string&)>& index) {
+        const AutomatonDecl& decl = *it.automaton;
+        const BcifsDecl& b = *decl.bcifs;
+        const BcifsSystem sys = bcifs_system(it, index);
+        const std::optional<BcifsSolution> sol = solve_bcifs(sys, d_);
+        if (!sol) throw AlreadyReported{};
+        std::vector<num::Rational> values(sol->variable_names.size());
+        std::vector<std::size_t> chosen; // the variables the compiler gave values
+        for (std::size_t p = 0; p < b.params.size(); ++p) {
+            const ParamDecl& d = b.params[p];
+            const num::Rational lo = d.lo ? exact_entry(*d.lo) : num::Rational(0);
+            const num::Rational hi = d.hi ? exact_entry(*d.hi) : num::Rational(1);
+            if (hi < lo) fail(d.loc, fmt::format("parameter '{}' has an empty range", d.name));
+            if (!d.value) {
+                values[p] = (lo + hi) / num::Rational(2);
+                chosen.push_back(p);
+                continue;
+            }
+            values[p] = exact_entry(*d.value);
+            if (values[p] < lo || values[p] > hi)
+                fail(d.value->loc, fmt::format("'{}' = {} is outside its range [{}, {}]", d.name,
+                                               values[p].to_string(), lo.to_string(), hi.to_string()));
+        }
+        const std::vector<num::Rational> uniform = most_uniform_values(sys, *sol, values);
+        for (std::size_t v : sol->free) chosen.push_back(v);
+        std::uint64_t state = 1;
+        const auto next = [&] { // splitmix64
+            std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+            z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+            z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+            return z ^ (z >> 31);
+        };
+        ir::Automaton& a = info.automaton;
+        a.initial = index(initial_state(decl).name);
+        const int attempts = sol->free.empty() ? 1 : 8;
+        bool contracts = false;
+        for (int attempt = 0; attempt < attempts && !contracts; ++attempt) {
+            for (std::size_t k = 0; k < sol->free.size(); ++k)
+                values[sol->free[k]] =
+                    uniform[k] + num::Rational(attempt == 0 ? 0 : static_cast<long>(next() % 9) - 4, 64);
+            a.arcs.clear();
+            a.embeddings.clear();
+            info.arc_locs.clear();
+            for (std::size_t j = 0; j < sys.operators.size(); ++j) {
+                const auto& o = sys.operators[j];
+                num::Matrix<num::Rational> m(o.rows, o.cols);
+                for (std::size_t r = 0; r < o.rows; ++r)
+                    for (std::size_t c = 0; c < o.cols; ++c) {
+                        const num::AffineForm& f = sol->entries[j][r * o.cols + c];
+                        num::Rational x = f.constant;
+                        for (const auto& [v, coef] : f.terms) x += coef * values[v];
+                        m(r, c) = x;
+                    }
+                ir::Arc arc;
+                arc.from = o.cell_index;
+                arc.to = index(b.operators[j].target);
+                arc.label = o.name;
+                arc.op = ir::Operator::from_exact(m);
+                if (b.operators[j].boundary) {
+                    a.embeddings.push_back(std::move(arc));
+                } else {
+                    a.arcs.push_back(std::move(arc));
+                    info.arc_locs.push_back(o.loc);
+                }
+            }
+            contracts = attempts == 1 || ir::prove_contractive(a).proven;
+        }
+        if (!contracts)
+            fail(it.loc,
+                 fmt::format("the compiler found no values of the {} free entries of '{}' that make it "
+                             "contractive (the most uniform operators and {} nearby); fix some of them "
+                             "(frac solve shows them)",
+                             sol->free.size(), it.name, attempts - 1));
+        info.solution = print_bcifs_solution(sys, *sol);
+        std::vector<std::string> given;
+        for (std::size_t p = 0; p < b.params.size(); ++p)
+            if (b.params[p].value)
+                given.push_back(fmt::format("{} = {}", b.params[p].name, values[p].to_string()));
+        if (!given.empty()) info.solution += fmt::format("  parameters: {}\n", fmt::join(given, ", "));
+        if (!chosen.empty()) {
+            std::vector<std::string> given;
+            for (std::size_t v : chosen)
+                given.push_back(fmt::format("{} = {}", sol->variable_names[v], values[v].to_string()));
+            info.solution += fmt::format("  values chosen: {}\n", fmt::join(given, ", "));
+        }
+        info.dof = sol->dof;
     }
 
     void automaton_info(const Item& it) {
@@ -716,6 +956,7 @@ private:
             a.states.push_back(std::move(st));
             info.state_locs.push_back(s.loc);
         }
+        if (decl.bcifs) bcifs_info(it, info, index);
         for (const ArcDecl& d : decl.arcs) {
             ir::Arc arc;
             arc.from = index(d.from);
@@ -731,9 +972,9 @@ private:
             a.arcs.push_back(std::move(arc));
             info.arc_locs.push_back(d.loc);
         }
-        a.initial = decl.initial.empty() ? 0 : index(decl.initial);
+        a.initial = index(initial_state(decl).name);
         if (decl.projection) a.projection = closed(*decl.projection, Context::constant).linear->in(0);
-        check(info);
+        check(info, decl.bcifs != nullptr);
         m_.automata.push_back(std::move(info));
         automaton_index_[&it] = m_.automata.size() - 1;
     }

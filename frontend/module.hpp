@@ -29,6 +29,10 @@ struct AutomatonInfo {
     ir::Automaton automaton;
     std::vector<Location> state_locs, arc_locs; // by state and arc index
     std::string contraction;                    // how the compiler proved that the system contracts
+    // A bcifs: the solution of its constraints as `frac solve` prints it (with the values its free
+    // entries took), and the degrees of freedom by state.
+    std::string solution;
+    std::vector<int> dof;
 };
 
 // A run-time question a test asks of a shape or an automaton; its answer is the input Var(index) of

@@ -83,6 +83,33 @@ ir::Operator add(const ir::Operator& a, const ir::Operator& b, bool subtract) {
     return ir::Operator::from_enclosure(subtract ? a.enclosure - b.enclosure : a.enclosure + b.enclosure);
 }
 
+namespace {
+
+num::Rational times(const num::Rational& a, const num::Rational& b) {
+    return a * b;
+}
+num::Interval times(num::Interval a, num::Interval b) {
+    return num::mul(a, b); // outward rounded
+}
+
+template <class T>
+num::Matrix<T> kronecker_of(const num::Matrix<T>& a, const num::Matrix<T>& b) {
+    num::Matrix<T> k(a.rows() * b.rows(), a.cols() * b.cols());
+    for (std::size_t r1 = 0; r1 < a.rows(); ++r1)
+        for (std::size_t c1 = 0; c1 < a.cols(); ++c1)
+            for (std::size_t r2 = 0; r2 < b.rows(); ++r2)
+                for (std::size_t c2 = 0; c2 < b.cols(); ++c2)
+                    k(r1 * b.rows() + r2, c1 * b.cols() + c2) = times(a(r1, c1), b(r2, c2));
+    return k;
+}
+
+} // namespace
+
+ir::Operator kronecker(const ir::Operator& a, const ir::Operator& b) {
+    if (a.exact && b.exact) return ir::Operator::from_exact(kronecker_of(*a.exact, *b.exact));
+    return ir::Operator::from_enclosure(kronecker_of(a.enclosure, b.enclosure));
+}
+
 LinearValue compose(const LinearValue& a, const LinearValue& b) {
     if (a.transform && b.transform) {
         LinearValue v;

@@ -33,6 +33,8 @@ ir::Operator operator_of(const std::vector<std::vector<Entry>>& rows);
 ir::Operator compose(const ir::Operator& a, const ir::Operator& b);
 ir::Operator scale_by(const Entry& s, const ir::Operator& a);
 ir::Operator add(const ir::Operator& a, const ir::Operator& b, bool subtract);
+// The Kronecker product: entry (r1 * rows(b) + r2, c1 * cols(b) + c2) is a(r1, c1) * b(r2, c2).
+ir::Operator kronecker(const ir::Operator& a, const ir::Operator& b);
 
 // a * b under the typing rule of types.cpp (compose_rule), which the type checker applied.
 LinearValue compose(const LinearValue& a, const LinearValue& b);

@@ -82,7 +82,8 @@ private:
     // `ifs` and `cifs` are words of the language only where a definition starts (they stay usable as
     // names elsewhere).
     bool at_automaton() const {
-        return at(Tok::ident) && (cur().text == "ifs" || cur().text == "cifs") && ahead(1).kind == Tok::ident;
+        return at(Tok::ident) && (cur().text == "ifs" || cur().text == "cifs" || cur().text == "bcifs") &&
+               ahead(1).kind == Tok::ident;
     }
     bool at_word(const char* word) const { return at(Tok::ident) && cur().text == word; }
 
@@ -159,7 +160,7 @@ private:
             return it;
         default:
             fail(fmt::format(
-                "expected a definition (fn, const, shape, ifs, cifs, test, import or print), found {}",
+                "expected a definition (fn, const, shape, ifs, cifs, bcifs, test, import or print), found {}",
                 describe(cur())));
         }
     }
@@ -167,12 +168,19 @@ private:
     // ifs NAME in SPACE { [LABEL =] OP [prob P]; ... [primitive = E;] }
     // cifs NAME { state a, b in SPACE; a -> b : [LABEL =] OP [prob P]; initial a; primitive a = E;
     //             project = controls(...); }
+    // bcifs NAME { cell v, e in bary(n); param p [in [lo, hi]] [= v]; subdivide e { T0 [-> c] = OP; }
+    //              boundary e from v { B0 = OP; } e.B0 * v.T0 == e.T0 * e.B0; fix e.T0[r][c] = E; ... }
     Item automaton(Item it) {
-        const bool graph_directed = take().text == "cifs";
+        const std::string word = take().text;
+        const bool graph_directed = word != "ifs";
         it.kind = ItemKind::automaton;
-        it.name = expect(Tok::ident, graph_directed ? "after 'cifs'" : "after 'ifs'").text;
+        it.name = expect(Tok::ident, word == "ifs"    ? "after 'ifs'"
+                                     : word == "cifs" ? "after 'cifs'"
+                                                      : "after 'bcifs'")
+                      .text;
         auto a = std::make_shared<AutomatonDecl>();
         a->graph_directed = graph_directed;
+        if (word == "bcifs") a->bcifs = std::make_shared<BcifsDecl>();
         if (!graph_directed) {
             if (!at(Tok::kw_in))
                 fail("expected 'in' and the space of the ifs (R2, R3 or bary(n)) after its name");
@@ -185,6 +193,7 @@ private:
                 automaton_stmt(*a, it.name);
             } catch (const CompileError& e) {
                 diags_.error(e.loc, e.what());
+                unknown_entries_ = false;
                 while (!at(Tok::semicolon) && !at(Tok::rbrace) && !at(Tok::end)) take();
                 accept(Tok::semicolon);
             }
@@ -195,16 +204,10 @@ private:
     }
 
     void automaton_stmt(AutomatonDecl& a, const std::string& name) {
-        if (a.graph_directed && at_word("state")) {
+        if (a.bcifs && bcifs_stmt(a)) return;
+        if (a.graph_directed && !a.bcifs && at_word("state")) {
             take();
-            std::vector<std::pair<std::string, Location>> names;
-            do {
-                const Token& n = expect(Tok::ident, "as a state name");
-                names.emplace_back(n.text, n.loc);
-            } while (accept(Tok::comma));
-            expect(Tok::kw_in, "and the states' space (R2, R3 or bary(n))");
-            const SpaceDecl s = space();
-            for (auto& [n, loc] : names) a.states.push_back({n, loc, s, nullptr});
+            state_list(a, "as a state name", "and the states' space (R2, R3 or bary(n))", 2);
         } else if (a.graph_directed && at_word("initial")) {
             take();
             const Token& n = expect(Tok::ident, "(the initial state) after 'initial'");
@@ -232,6 +235,8 @@ private:
             take();
             expect(Tok::assign, "after 'project'");
             a.projection = expr();
+        } else if (a.bcifs) {
+            a.bcifs->constraints.push_back(constraint());
         } else {
             ArcDecl arc;
             arc.loc = cur().loc;
@@ -263,8 +268,181 @@ private:
         expect(Tok::semicolon, "after the statement");
     }
 
+    // NAME, NAME ... in SPACE: states (cells) of one space.
+    void state_list(AutomatonDecl& a, const char* name_what, const char* space_what, int min_weights) {
+        std::vector<std::pair<std::string, Location>> names;
+        do {
+            const Token& n = expect(Tok::ident, name_what);
+            names.emplace_back(n.text, n.loc);
+        } while (accept(Tok::comma));
+        expect(Tok::kw_in, space_what);
+        const SpaceDecl s = space(min_weights);
+        for (auto& [n, loc] : names) a.states.push_back({n, loc, s, nullptr});
+    }
+
+    // The statements only a bcifs has; false when the statement is a common one (initial, primitive,
+    // project) or a constraint. Block statements take their own closing brace (and an optional ';').
+    bool bcifs_stmt(AutomatonDecl& a) {
+        BcifsDecl& b = *a.bcifs;
+        if (at_word("cell")) {
+            take();
+            state_list(a, "as a cell name", "and the cells' space (bary(n), R2 or R3)", 1);
+        } else if (at_word("param")) {
+            take();
+            ParamDecl p;
+            const Token& n = expect(Tok::ident, "as the parameter's name");
+            p.name = n.text;
+            p.loc = n.loc;
+            if (accept(Tok::kw_in)) {
+                expect(Tok::lbracket, "to open the parameter's range [lo, hi]");
+                p.lo = expr();
+                expect(Tok::comma, "between the range's bounds");
+                p.hi = expr();
+                expect(Tok::rbracket, "to close the parameter's range");
+            }
+            if (accept(Tok::assign)) p.value = expr();
+            b.params.push_back(std::move(p));
+        } else if (at_word("subdivide") || at_word("boundary")) {
+            const bool boundary = take().text == "boundary";
+            const Token& cell = expect(Tok::ident, "(a cell)");
+            std::string from;
+            Location from_loc;
+            if (boundary) {
+                if (!at_word("from"))
+                    fail("expected 'from' and the embedded cell (boundary e from v { ... })");
+                take();
+                const Token& f = expect(Tok::ident, "(the embedded cell) after 'from'");
+                from = f.text;
+                from_loc = f.loc;
+            }
+            expect(Tok::lbrace,
+                   boundary ? "to open the boundary operators" : "to open the subdivision operators");
+            while (!at(Tok::rbrace) && !at(Tok::end)) {
+                OperatorDecl op;
+                op.cell = cell.text;
+                op.boundary = boundary;
+                const Token& label = expect(Tok::ident, "as the operator's name (T0, B1, ...)");
+                op.name = label.text;
+                op.loc = label.loc;
+                op.target = boundary ? from : cell.text;
+                op.target_loc = boundary ? from_loc : cell.loc;
+                if (!boundary && accept(Tok::minus)) {
+                    expect(Tok::gt, "after '-' (T1 -> c = ...: a subdivision into the cell c)");
+                    const Token& t = expect(Tok::ident, "(the target cell) after '->'");
+                    op.target = t.text;
+                    op.target_loc = t.loc;
+                }
+                expect(Tok::assign, "after the operator's name");
+                if (!accept(Tok::question)) {
+                    unknown_entries_ = true;
+                    op.value = expr();
+                    unknown_entries_ = false;
+                }
+                expect(Tok::semicolon, "after the operator");
+                b.operators.push_back(std::move(op));
+            }
+            expect(Tok::rbrace, "to close the operators");
+            accept(Tok::semicolon);
+            return true;
+        } else if (at_word("topology")) {
+            take();
+            TopologyDecl t;
+            const Token& cell = expect(Tok::ident, "(a cell) after 'topology'");
+            t.cell = cell.text;
+            t.loc = cell.loc;
+            expect(Tok::assign, "after the cell (topology f = quad(e) split 2 x 2)");
+            const Token& kind = expect(Tok::ident, "(edge or quad)");
+            t.kind = kind.text;
+            t.kind_loc = kind.loc;
+            if (t.kind != "edge" && t.kind != "quad")
+                throw CompileError(kind.loc,
+                                   fmt::format("no topology '{}': the topologies are edge(v) split n "
+                                               "and quad(e) split n x n",
+                                               t.kind));
+            expect(Tok::lparen, "after the topology");
+            const Token& of = expect(Tok::ident, t.kind == "edge" ? "(the vertex cell)" : "(the edge cell)");
+            t.of = of.text;
+            t.of_loc = of.loc;
+            expect(Tok::rparen, "after the boundary cell");
+            if (!at_word("split")) fail("expected 'split' and the number of parts");
+            take();
+            t.n = count();
+            if (t.kind == "quad") {
+                if (!at_word("x") && !at(Tok::times) && !at(Tok::star))
+                    fail("expected 'x' and the parts along t");
+                take();
+                t.m = count();
+            }
+            b.topologies.push_back(std::move(t));
+        } else if (at_word("fix")) {
+            take();
+            FixDecl f;
+            f.loc = cur().loc;
+            f.cell = expect(Tok::ident, "(a cell) after 'fix'").text;
+            expect(Tok::dot, "after the cell (fix e.T0[r][c] = value)");
+            f.name = expect(Tok::ident, "(an operator) after the cell").text;
+            f.index_loc = cur().loc;
+            f.row = index();
+            f.col = index();
+            expect(Tok::assign, "after the entry");
+            f.value = expr();
+            b.fixes.push_back(std::move(f));
+        } else {
+            return false;
+        }
+        expect(Tok::semicolon, "after the statement");
+        return true;
+    }
+
+    // The number of parts of a topology: 1 to 16.
+    int count() {
+        const Token& n = expect(Tok::number, "(the number of parts)");
+        const int v = std::atoi(n.text.c_str());
+        if (n.text.find_first_not_of("0123456789") != std::string::npos || n.text.size() > 2 || v < 1 ||
+            v > 16)
+            throw CompileError(n.loc, fmt::format("a topology splits into 1 to 16 parts, not {}", n.text));
+        return v;
+    }
+
+    // [k]: an entry index, counted from 0.
+    int index() {
+        expect(Tok::lbracket, "(an entry index [row][column], counted from 0)");
+        const Token& n = expect(Tok::number, "as an entry index");
+        if (n.text.find_first_not_of("0123456789") != std::string::npos || n.text.size() > 4)
+            throw CompileError(n.loc, fmt::format("an entry index is a whole number, not {}", n.text));
+        expect(Tok::rbracket, "after the entry index");
+        return std::atoi(n.text.c_str());
+    }
+
+    // PRODUCT == PRODUCT, where each factor is an operator cell.name or a constant matrix.
+    ConstraintDecl constraint() {
+        ConstraintDecl c;
+        c.loc = cur().loc;
+        c.left = product();
+        expect(Tok::eq, "(a constraint: a product of operators == another)");
+        c.right = product();
+        return c;
+    }
+    std::vector<FactorDecl> product() {
+        std::vector<FactorDecl> factors;
+        do {
+            FactorDecl f;
+            f.loc = cur().loc;
+            if (at(Tok::ident) && ahead(1).kind == Tok::dot && ahead(2).kind == Tok::ident &&
+                !aliases_.count(cur().text)) {
+                f.cell = take().text;
+                take();
+                f.name = take().text;
+            } else {
+                f.constant = unary_expr();
+            }
+            factors.push_back(std::move(f));
+        } while (accept(Tok::star));
+        return factors;
+    }
+
     // R2, R3 or bary(n).
-    SpaceDecl space() {
+    SpaceDecl space(int min_weights = 2) {
         SpaceDecl s;
         s.loc = cur().loc;
         if (at(Tok::ident) && (cur().text == "R2" || cur().text == "R3")) {
@@ -277,9 +455,9 @@ private:
             expect(Tok::lparen, "after 'bary'");
             const Token& n = expect(Tok::number, "(the number of weights) in bary(n)");
             const int v = std::atoi(n.text.c_str());
-            if (v < 2 || v > 16 || n.text.find_first_not_of("0123456789") != std::string::npos)
-                throw CompileError(n.loc,
-                                   fmt::format("bary(n) needs an integer n from 2 to 16, not {}", n.text));
+            if (v < min_weights || v > 64 || n.text.find_first_not_of("0123456789") != std::string::npos)
+                throw CompileError(n.loc, fmt::format("bary(n) needs an integer n from {} to 64, not {}",
+                                                      min_weights, n.text));
             expect(Tok::rparen, "after bary(n)");
             s.barycentric = true;
             s.n = v;
@@ -530,6 +708,13 @@ private:
             expect(Tok::rbracket, "to close the interval");
             return e;
         }
+        case Tok::question: {
+            if (!unknown_entries_)
+                fail("'?' (an unknown entry) is written only in a bcifs operator's matrix");
+            auto e = make(ExprKind::name, tok.loc);
+            e->text = take().text; // "?"
+            return e;
+        }
         case Tok::kw_fn:
             fail("an anonymous function 'fn (...) = ...' is only an argument, where a function is expected");
         default: fail(fmt::format("expected an expression, found {}", describe(tok)));
@@ -614,6 +799,7 @@ private:
     std::size_t pos_ = 0;
     int depth_ = 0;
     int operators_ = 0;
+    bool unknown_entries_ = false; // inside a bcifs operator: `?` is an unknown entry
 };
 
 } // namespace

@@ -180,9 +180,10 @@ private:
         const auto known = [&](const std::string& name, Location loc, const char* what) {
             if (states.count(name)) return;
             const auto near = closest_name(name, names);
-            d_.error(loc,
-                     fmt::format("{} '{}' is no state of this automaton{} (states: {})", what, name,
-                                 near ? fmt::format("; did you mean '{}'?", *near) : "", list_names(names)));
+            d_.error(loc, fmt::format("{} '{}' is no {} of this {}{} ({}: {})", what, name,
+                                      a.bcifs ? "cell" : "state", a.bcifs ? "bcifs" : "automaton",
+                                      near ? fmt::format("; did you mean '{}'?", *near) : "",
+                                      a.bcifs ? "cells" : "states", list_names(names)));
         };
         for (const ArcDecl& arc : a.arcs) {
             known(arc.from, arc.from_loc, "the arc's source");
@@ -194,7 +195,71 @@ private:
         if (a.projection) expr(*a.projection);
         if (a.states.empty())
             d_.error(checked_->loc, fmt::format("automaton '{}' has no state", checked_->name));
-        if (a.arcs.empty()) d_.error(checked_->loc, fmt::format("automaton '{}' has no map", checked_->name));
+        if (a.bcifs) {
+            bcifs(*a.bcifs, known);
+        } else if (a.arcs.empty()) {
+            d_.error(checked_->loc, fmt::format("automaton '{}' has no map", checked_->name));
+        }
+    }
+
+    // Operators are named cell.name, each defined once; the parameters are names of the entries only.
+    template <class Known>
+    void bcifs(const BcifsDecl& b, const Known& known_cell) {
+        std::map<std::pair<std::string, std::string>, Location> operators;
+        for (const OperatorDecl& op : b.operators) {
+            known_cell(op.cell, op.loc, "the operator's cell");
+            known_cell(op.target, op.target_loc, op.boundary ? "the embedded cell" : "the target cell");
+            if (auto [pos, added] = operators.emplace(std::pair{op.cell, op.name}, op.loc); !added) {
+                d_.error(op.loc, fmt::format("operator '{}.{}' is already defined", op.cell, op.name));
+                d_.note(pos->second, fmt::format("'{}.{}' was first defined here", op.cell, op.name));
+            }
+        }
+        if (operators.empty())
+            d_.error(checked_->loc, fmt::format("bcifs '{}' has no operator", checked_->name));
+        const auto known_operator = [&](const std::string& cell, const std::string& name, Location loc) {
+            if (operators.count({cell, name})) return;
+            std::vector<std::string> names;
+            for (const auto& [key, where] : operators)
+                if (key.first == cell) names.push_back(key.first + "." + key.second);
+            d_.error(loc, fmt::format("'{}.{}' is no operator of this bcifs{}", cell, name,
+                                      names.empty() ? fmt::format(" ('{}' has none)", cell)
+                                                    : fmt::format(" (operators of '{}': {})", cell,
+                                                                  list_names(names))));
+        };
+        std::map<std::string, Location> params;
+        for (const ParamDecl& p : b.params) {
+            if (auto [pos, added] = params.emplace(p.name, p.loc); !added) {
+                d_.error(p.loc, fmt::format("parameter '{}' is already defined", p.name));
+                d_.note(pos->second, fmt::format("'{}' was first defined here", p.name));
+            }
+            for (const Expr* e : {p.lo.get(), p.hi.get(), p.value.get()})
+                if (e) expr(*e);
+        }
+        scopes_.emplace_back();
+        for (const auto& [name, loc] : params) scopes_.back().emplace(name, value);
+        for (const OperatorDecl& op : b.operators) {
+            if (!op.value) continue;
+            if (op.value->kind != ExprKind::matrix) {
+                expr(*op.value);
+                continue;
+            }
+            for (const ExprPtr& row : op.value->kids)
+                for (const ExprPtr& entry : row->kids)
+                    if (!is_unknown(*entry)) expr(*entry);
+        }
+        for (const FixDecl& f : b.fixes) {
+            known_operator(f.cell, f.name, f.loc);
+            expr(*f.value);
+        }
+        scopes_.pop_back();
+        for (const ConstraintDecl& c : b.constraints)
+            for (const auto* side : {&c.left, &c.right})
+                for (const FactorDecl& f : *side) {
+                    if (f.constant)
+                        expr(*f.constant);
+                    else
+                        known_operator(f.cell, f.name, f.loc);
+                }
     }
 
     // The kind of a local name: `value`, a function parameter's arity, or nullopt when not local.
@@ -216,8 +281,11 @@ private:
         switch (e.kind) {
         case ExprKind::number: return;
         case ExprKind::name:
-            if (names_function(e.text) && !is_builtin_constant(e.text) &&
-                (is_local(e.text) || globals_.count(e.text))) {
+            if (is_unknown(e)) {
+                d_.error(e.loc,
+                         "'?' (an unknown) is a whole entry of an operator's matrix, or the whole operator");
+            } else if (names_function(e.text) && !is_builtin_constant(e.text) &&
+                       (is_local(e.text) || globals_.count(e.text))) {
                 d_.error(e.loc, fmt::format("'{}' is a function; call it with arguments, or pass it where a "
                                             "function is expected",
                                             e.text));

@@ -3,6 +3,7 @@
 #include "frontend/builtins.hpp"
 #include "frontend/inliner.hpp"
 
+#include <algorithm>
 #include <fmt/format.h>
 #include <map>
 #include <memory>
@@ -344,6 +345,22 @@ private:
             require_number(expr(*e.args[1].value).type, e.args[1].loc);
             return TValue::of(Type::point(a.size));
         }
+        if (b.kind == BuiltinKind::dof) {
+            if (frames_.back().ctx != Context::test)
+                fail(e.loc, "'dof' reads the solution of a bcifs; it is available in tests and print only");
+            const Expr& a = *e.args[0].value;
+            const Item* it = nullptr;
+            if (a.kind == ExprKind::field && a.kids[0]->kind == ExprKind::name)
+                if (auto g = globals_.find(a.kids[0]->text); g != globals_.end()) it = g->second;
+            if (!it || it->kind != ItemKind::automaton || !it->automaton->bcifs)
+                fail(a.loc, "'dof' counts the free entries of a cell of a bcifs: dof(name.cell)");
+            automaton_type(*it);
+            const auto& states = it->automaton->states;
+            if (std::none_of(states.begin(), states.end(),
+                             [&](const StateDecl& s) { return s.name == a.text; }))
+                fail(a.loc, fmt::format("bcifs '{}' has no cell '{}'", it->name, a.text));
+            return TValue::of(Type::number());
+        }
         if (b.kind == BuiltinKind::distance) {
             if (frames_.back().ctx == Context::constant)
                 fail(e.loc, "'dist' is computed by the runtime: it is not a constant expression");
@@ -363,6 +380,18 @@ private:
             return TValue::of(Type::number());
         }
         if (b.kind == BuiltinKind::controls) return TValue::of(controls_type(e));
+        if (b.kind == BuiltinKind::kron) {
+            Type t[2];
+            for (int k = 0; k < 2; ++k) {
+                t[k] = expr(*e.args[k].value).type;
+                if (t[k].kind != Type::Kind::matrix)
+                    fail(e.args[k].loc,
+                         fmt::format("'kron' multiplies two matrices, found {}", type_name(t[k])));
+            }
+            if (t[0].rows * t[1].rows > 4096 || t[0].cols * t[1].cols > 4096)
+                fail(e.loc, "'kron' would make a matrix of more than 4096 rows or columns");
+            return TValue::of(Type::matrix(t[0].rows * t[1].rows, t[0].cols * t[1].cols));
+        }
         if (b.kind == BuiltinKind::primitive)
             fail(e.loc,
                  fmt::format("'{}' draws a state of an automaton: it is written after 'primitive' only",
@@ -419,9 +448,7 @@ private:
         }
         // Its size: the dimension of the space its attractor is drawn in.
         const AutomatonDecl& a = *it.automaton;
-        const StateDecl* initial = &a.states.front();
-        for (const StateDecl& s : a.states)
-            if (s.name == a.initial) initial = &s;
+        const StateDecl* initial = &initial_state(a);
         const int drawn = initial->space.barycentric ? closed(*a.projection, Context::constant).type.rows - 1
                                                      : initial->space.n;
         return out_.items[&it] = Type{Type::Kind::automaton, drawn};
@@ -462,7 +489,8 @@ private:
             if (arc.probability)
                 require_number(closed(*arc.probability, Context::constant).type, arc.probability->loc);
         }
-        const StateDecl& initial = a.initial.empty() ? a.states.front() : state(a.initial);
+        if (a.bcifs) check_bcifs(a, state);
+        const StateDecl& initial = initial_state(a);
         if (a.projection) {
             const Type p = closed(*a.projection, Context::constant).type;
             if (!initial.space.barycentric)
@@ -483,6 +511,92 @@ private:
         }
         for (const StateDecl& s : a.states)
             if (s.primitive) primitive_type(s);
+    }
+
+    // The operators' sizes follow from the cells' spaces; every constraint's products are defined and
+    // both sides have one size; the entries and fixed values are numbers (the parameters are numbers).
+    template <class State>
+    void check_bcifs(const AutomatonDecl& a, const State& state) {
+        const BcifsDecl& b = *a.bcifs;
+        for (const ParamDecl& p : b.params)
+            for (const Expr* e : {p.lo.get(), p.hi.get(), p.value.get()})
+                if (e) require_number(closed(*e, Context::constant).type, e->loc);
+        std::map<std::pair<std::string, std::string>, const OperatorDecl*> operators;
+        const auto size_of = [&](const OperatorDecl& op) {
+            return std::pair{coordinates(state(op.cell).space), coordinates(state(op.target).space)};
+        };
+        for (const OperatorDecl& op : b.operators) {
+            operators[{op.cell, op.name}] = &op;
+            if (!op.value) continue;
+            const auto [rows, cols] = size_of(op);
+            const std::string what =
+                fmt::format("'{}.{}' maps {} ('{}') into {} ('{}'), so it is a {}×{} matrix", op.cell,
+                            op.name, space_text(state(op.target).space), op.target,
+                            space_text(state(op.cell).space), op.cell, rows, cols);
+            if (op.value->kind == ExprKind::matrix) {
+                const auto& m = op.value->kids;
+                if (static_cast<int>(m.size()) != rows || static_cast<int>(m.front()->kids.size()) != cols)
+                    fail(op.value->loc,
+                         fmt::format("{}; this one is {}×{}", what, m.size(), m.front()->kids.size()));
+                for (const ExprPtr& row : m)
+                    for (const ExprPtr& entry : row->kids)
+                        if (!is_unknown(*entry)) require_number(with_params(b, *entry).type, entry->loc);
+                continue;
+            }
+            const Type t = closed(*op.value, Context::constant).type;
+            if (t.kind != Type::Kind::matrix || t.rows != rows || t.cols != cols)
+                fail(op.value->loc, fmt::format("{}; found {}", what, type_name(t)));
+        }
+        for (const FixDecl& f : b.fixes) {
+            const auto [rows, cols] = size_of(*operators.at({f.cell, f.name}));
+            if (f.row >= rows || f.col >= cols)
+                fail(f.index_loc, fmt::format("'{}.{}' is {}×{}: entry [{}][{}] is outside it (indices count "
+                                              "from 0)",
+                                              f.cell, f.name, rows, cols, f.row, f.col));
+            require_number(with_params(b, *f.value).type, f.value->loc);
+        }
+        for (const ConstraintDecl& c : b.constraints) {
+            std::pair<int, int> sides[2];
+            for (int k = 0; k < 2; ++k) {
+                const std::vector<FactorDecl>& side = k == 0 ? c.left : c.right;
+                std::optional<std::pair<int, int>> size;
+                std::string text;
+                for (const FactorDecl& f : side) {
+                    std::pair<int, int> fs;
+                    if (f.constant) {
+                        const Type t = closed(*f.constant, Context::constant).type;
+                        if (t.kind != Type::Kind::matrix)
+                            fail(f.loc, fmt::format("a factor of a constraint is an operator or a matrix, "
+                                                    "found {}",
+                                                    type_name(t)));
+                        fs = {t.rows, t.cols};
+                    } else {
+                        fs = size_of(*operators.at({f.cell, f.name}));
+                    }
+                    const std::string name =
+                        f.constant ? fmt::format("a {}×{} matrix", fs.first, fs.second)
+                                   : fmt::format("{}.{} ({}×{})", f.cell, f.name, fs.first, fs.second);
+                    if (size && size->second != fs.first)
+                        fail(f.loc, fmt::format("{} has {} columns, so it cannot be multiplied by {}", text,
+                                                size->second, name));
+                    size = size ? std::pair{size->first, fs.second} : fs;
+                    text = text.empty() ? name : text + " * " + name;
+                }
+                sides[k] = *size;
+            }
+            if (sides[0] != sides[1])
+                fail(c.loc, fmt::format("the two sides of this constraint differ in size: {}×{} and {}×{}",
+                                        sides[0].first, sides[0].second, sides[1].first, sides[1].second));
+        }
+    }
+
+    // An entry of an operator or a fixed value: a constant in which the bcifs's parameters are numbers.
+    TValue with_params(const BcifsDecl& b, const Expr& e) {
+        return in_closed_frame(Context::constant, [&] {
+            for (const ParamDecl& p : b.params)
+                frames_.back().scopes.back().emplace_back(p.name, TValue::of(Type::number()));
+            return expr(e);
+        });
     }
 
     // point(p), segment(p, q), polyline(p, ...), polygon(p, ...) of points in a euclidean state's space;
@@ -677,7 +791,11 @@ std::string print_types(const Program& program, const TypedProgram& typed, std::
         case ItemKind::print: out += fmt::format("print : {}\n", type_of(it.body.get())); break;
         case ItemKind::automaton: {
             const AutomatonDecl& a = *it.automaton;
-            out += fmt::format("{} {} : automaton\n", a.graph_directed ? "cifs" : "ifs", it.name);
+            out += fmt::format("{} {} : automaton\n",
+                               a.bcifs            ? "bcifs"
+                               : a.graph_directed ? "cifs"
+                                                  : "ifs",
+                               it.name);
             for (const ArcDecl& arc : a.arcs)
                 out += fmt::format("  {} -> {}{} : {}\n", arc.from, arc.to,
                                    arc.label.empty() ? "" : " " + arc.label, type_of(arc.op.get()));

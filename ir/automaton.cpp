@@ -101,6 +101,11 @@ std::string print_automaton(const Automaton& a) {
         out += arc.op.exact ? " (exact)\n" : "\n";
         out += matrix_text(arc.op, "    ");
     }
+    for (const Arc& b : a.embeddings) {
+        out += fmt::format("  boundary {} <- {} {}{}\n", a.states.at(b.from).name, a.states.at(b.to).name,
+                           b.label, b.op.exact ? " (exact)" : "");
+        out += matrix_text(b.op, "    ");
+    }
     if (a.projection) {
         out += "  projection\n";
         out += matrix_text(*a.projection, "    ");

@@ -87,6 +87,10 @@ struct Automaton {
     // For a barycentric initial state: the control points as the columns of a (d + 1) x n homogeneous
     // matrix bary(n) -> R^d. Empty when the initial state is euclidean (its space is the picture's).
     std::optional<Operator> projection;
+    // A BCIFS's boundary (embedding) operators B : X^to -> X^from (seed 002): they place a lower cell's
+    // attractor inside a higher one's and are no part of the union that defines an attractor, so they
+    // are kept apart from the arcs (junctions, shared boundaries and meshes use them).
+    std::vector<Arc> embeddings;
 
     // The arcs leaving state s, in model order.
     std::vector<std::size_t> arcs_from(std::size_t s) const;

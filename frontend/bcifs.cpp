@@ -1,0 +1,348 @@
+#include "frontend/bcifs.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <map>
+
+namespace frac::front {
+
+namespace {
+
+using num::AffineForm;
+using num::Rational;
+using Forms = std::vector<AffineForm>; // a matrix's entries, row by row
+
+// The form with every variable replaced by its current value.
+AffineForm substitute(const AffineForm& f, const std::vector<AffineForm>& values) {
+    AffineForm out;
+    out.constant = f.constant;
+    for (const auto& [v, a] : f.terms) out.add_scaled(values[v], a);
+    return out;
+}
+
+struct Product {
+    Forms entries;
+    std::size_t rows = 0, cols = 0;
+    bool linear = true;
+    std::vector<std::size_t> unknown_factors; // indices of factors with non-constant entries
+};
+
+// a (r x k) * b (k x c); not linear when both have a non-constant entry.
+Product multiply(const Product& a, const Forms& b, std::size_t b_cols) {
+    const bool b_constant =
+        std::all_of(b.begin(), b.end(), [](const AffineForm& f) { return f.is_constant(); });
+    const bool a_constant =
+        std::all_of(a.entries.begin(), a.entries.end(), [](const AffineForm& f) { return f.is_constant(); });
+    Product p;
+    p.rows = a.rows;
+    p.cols = b_cols;
+    p.linear = a.linear && (a_constant || b_constant);
+    if (!p.linear) return p;
+    p.entries.assign(p.rows * p.cols, AffineForm{});
+    for (std::size_t i = 0; i < p.rows; ++i)
+        for (std::size_t j = 0; j < p.cols; ++j) {
+            AffineForm& out = p.entries[i * p.cols + j];
+            for (std::size_t k = 0; k < a.cols; ++k) {
+                const AffineForm &x = a.entries[i * a.cols + k], &y = b[k * b_cols + j];
+                if (x.is_constant())
+                    out.add_scaled(y, x.constant);
+                else
+                    out.add_scaled(x, y.constant);
+            }
+        }
+    return p;
+}
+
+std::string letters(std::size_t k) {
+    std::string s;
+    do {
+        s.insert(s.begin(), static_cast<char>('a' + k % 26));
+        k /= 26;
+    } while (k-- > 0);
+    return s;
+}
+
+} // namespace
+
+std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& sys, Diagnostics& diags) {
+    // Variables: the parameters, then each operator's unknown entries column by column.
+    std::vector<Forms> forms(sys.operators.size());
+    struct Origin {
+        std::size_t op, row, col;
+    };
+    std::vector<Origin> origin(sys.params.size(), Origin{0, 0, 0});
+    for (std::size_t j = 0; j < sys.operators.size(); ++j) {
+        const auto& op = sys.operators[j];
+        forms[j].resize(op.rows * op.cols);
+        for (std::size_t c = 0; c < op.cols; ++c)
+            for (std::size_t r = 0; r < op.rows; ++r) {
+                const auto& known = op.entries[r * op.cols + c];
+                if (known) {
+                    forms[j][r * op.cols + c] = *known;
+                } else {
+                    forms[j][r * op.cols + c] = AffineForm::variable(origin.size());
+                    origin.push_back({j, r, c});
+                }
+            }
+    }
+    const std::size_t variables = origin.size();
+    const std::size_t column_sums = sys.constraints.size(), fixes = column_sums + sys.operators.size();
+
+    std::vector<AffineForm> values(variables);
+    for (std::size_t v = 0; v < variables; ++v) values[v] = AffineForm::variable(v);
+    std::vector<bool> linear(sys.constraints.size(), false);
+    std::size_t linear_count = 0;
+    num::LinearSolution solution;
+    std::size_t equations = 0;
+    for (;;) {
+        num::LinearSystem system(variables);
+        const auto current = [&](std::size_t j) {
+            Forms f = forms[j];
+            for (AffineForm& e : f) e = substitute(e, values);
+            return f;
+        };
+        for (std::size_t j = 0; j < sys.operators.size(); ++j) {
+            const auto& op = sys.operators[j];
+            if (!op.barycentric) continue;
+            const Forms f = current(j);
+            for (std::size_t c = 0; c < op.cols; ++c) {
+                AffineForm sum;
+                sum.constant = Rational(-1);
+                for (std::size_t r = 0; r < op.rows; ++r) sum += f[r * op.cols + c];
+                system.add(std::move(sum), column_sums + j);
+            }
+        }
+        for (std::size_t k = 0; k < sys.fixes.size(); ++k) {
+            const auto& fx = sys.fixes[k];
+            const auto& op = sys.operators[fx.op];
+            system.add(substitute(forms[fx.op][fx.row * op.cols + fx.col], values) -
+                           substitute(fx.value, values),
+                       fixes + k);
+        }
+        std::size_t now_linear = 0;
+        for (std::size_t k = 0; k < sys.constraints.size(); ++k) {
+            const auto& c = sys.constraints[k];
+            Product sides[2];
+            for (int s = 0; s < 2; ++s) {
+                const auto& factors = s == 0 ? c.left : c.right;
+                Product p;
+                for (std::size_t i = 0; i < factors.size(); ++i) {
+                    const auto& f = factors[i];
+                    Forms m;
+                    std::size_t rows, cols;
+                    if (f.op) {
+                        m = current(*f.op);
+                        rows = sys.operators[*f.op].rows;
+                        cols = sys.operators[*f.op].cols;
+                    } else {
+                        rows = f.constant.rows();
+                        cols = f.constant.cols();
+                        for (std::size_t r = 0; r < rows; ++r)
+                            for (std::size_t cc = 0; cc < cols; ++cc) {
+                                AffineForm e;
+                                e.constant = f.constant(r, cc);
+                                m.push_back(e);
+                            }
+                    }
+                    if (i == 0) {
+                        p.entries = std::move(m);
+                        p.rows = rows;
+                        p.cols = cols;
+                    } else {
+                        p = multiply(p, m, cols);
+                        if (!p.linear) break;
+                    }
+                }
+                sides[s] = std::move(p);
+            }
+            if (!sides[0].linear || !sides[1].linear) continue;
+            linear[k] = true;
+            ++now_linear;
+            for (std::size_t e = 0; e < sides[0].entries.size(); ++e)
+                system.add(sides[0].entries[e] - sides[1].entries[e], k);
+        }
+        equations = system.equations();
+        solution = system.solve();
+        if (!solution.consistent) {
+            diags.error(
+                sys.constraints.empty()                   ? sys.operators.front().loc
+                : solution.conflict.front() < column_sums ? sys.constraints[solution.conflict.front()].loc
+                                                          : sys.operators.front().loc,
+                solution.conflict.size() == 1
+                    ? fmt::format("a constraint of bcifs '{}' cannot hold with these operators", sys.name)
+                    : fmt::format("the constraints of bcifs '{}' conflict: no operators satisfy these {} "
+                                  "together (without any one of them the rest have a solution)",
+                                  sys.name, solution.conflict.size()));
+            for (std::size_t s : solution.conflict) {
+                if (s < column_sums) {
+                    diags.note(sys.constraints[s].loc, fmt::format("constraint {}", sys.constraints[s].text));
+                } else if (s < fixes) {
+                    const auto& op = sys.operators[s - column_sums];
+                    diags.note(op.loc, fmt::format("the columns of {}.{} sum to 1 (a barycentric operator)",
+                                                   op.cell, op.name));
+                } else {
+                    const auto& fx = sys.fixes[s - fixes];
+                    const auto& op = sys.operators[fx.op];
+                    diags.note(fx.loc, fmt::format("fix {}.{}[{}][{}]", op.cell, op.name, fx.row, fx.col));
+                }
+            }
+            return std::nullopt;
+        }
+        values = solution.values;
+        if (now_linear == sys.constraints.size()) break;
+        if (now_linear == linear_count) {
+            // Nothing more can be determined: the first constraint still bilinear is the error.
+            std::size_t k = 0;
+            while (linear[k]) ++k;
+            const auto& c = sys.constraints[k];
+            std::vector<std::string> unknown;
+            for (const auto* side : {&c.left, &c.right})
+                for (const auto& f : *side)
+                    if (f.op) {
+                        const Forms cur = [&] {
+                            Forms m = forms[*f.op];
+                            for (AffineForm& e : m) e = substitute(e, values);
+                            return m;
+                        }();
+                        const std::string name =
+                            fmt::format("{}.{}", sys.operators[*f.op].cell, sys.operators[*f.op].name);
+                        if (std::find(unknown.begin(), unknown.end(), name) == unknown.end() &&
+                            std::any_of(cur.begin(), cur.end(),
+                                        [](const AffineForm& e) { return !e.is_constant(); }))
+                            unknown.push_back(name);
+                    }
+            diags.error(
+                c.loc,
+                fmt::format("this constraint multiplies operators whose entries are not determined ({}): "
+                            "a product of unknowns is not linear, and the other constraints do not "
+                            "determine all but one factor of each product; fix the entries of one of them",
+                            fmt::join(unknown, ", ")));
+            return std::nullopt;
+        }
+        linear_count = now_linear;
+    }
+
+    BcifsSolution out;
+    out.unknowns = variables - sys.params.size();
+    out.equations = equations;
+    out.rank = solution.rank;
+    for (std::size_t j = 0; j < sys.operators.size(); ++j) {
+        Forms f = forms[j];
+        for (AffineForm& e : f) e = substitute(e, values);
+        out.entries.push_back(std::move(f));
+    }
+    // Names: the parameters' own, then one letter per (operator, column) of the free entries.
+    out.variable_names.assign(variables, "");
+    for (std::size_t p = 0; p < sys.params.size(); ++p) out.variable_names[p] = sys.params[p];
+    std::map<std::pair<std::size_t, std::size_t>, std::string> group;
+    std::size_t next = 0;
+    for (std::size_t v : solution.free) {
+        if (v < sys.params.size()) continue;
+        out.free.push_back(v);
+        const auto key = std::pair{origin[v].op, origin[v].col};
+        if (!group.count(key)) {
+            std::string l;
+            do l = letters(next++);
+            while (std::find(sys.params.begin(), sys.params.end(), l) != sys.params.end());
+            group[key] = l;
+        }
+        out.variable_names[v] = fmt::format("{}{}", group[key], origin[v].row);
+    }
+    // Degrees of freedom: a free entry belongs to the lowest cell whose operators use it.
+    out.dof.assign(sys.cells.size(), 0);
+    for (std::size_t v : out.free) {
+        std::optional<std::size_t> owner;
+        for (std::size_t j = 0; j < sys.operators.size(); ++j) {
+            const std::size_t cell = sys.operators[j].cell_index;
+            const bool uses = std::any_of(out.entries[j].begin(), out.entries[j].end(),
+                                          [&](const AffineForm& e) { return e.terms.count(v) > 0; });
+            if (uses && (!owner || sys.cell_order[cell] < sys.cell_order[*owner])) owner = cell;
+        }
+        if (owner) ++out.dof[*owner];
+    }
+    return out;
+}
+
+std::vector<Rational> most_uniform_values(const BcifsSystem& sys, const BcifsSolution& sol,
+                                          const std::vector<Rational>& params) {
+    const std::size_t n = sol.free.size();
+    if (n == 0) return {};
+    std::map<std::size_t, std::size_t> column; // free variable -> its column in the least-squares system
+    for (std::size_t k = 0; k < n; ++k) column[sol.free[k]] = k;
+    // Normal equations (A^T A) x = A^T b, accumulated entry by entry: each entry is a row of A.
+    num::Matrix<Rational> normal(n, n), rhs(n, 1);
+    for (std::size_t j = 0; j < sys.operators.size(); ++j) {
+        const auto& op = sys.operators[j];
+        if (!op.barycentric) continue;
+        const Rational target(1, static_cast<long>(op.rows));
+        for (const AffineForm& f : sol.entries[j]) {
+            std::vector<std::pair<std::size_t, Rational>> row;
+            Rational b = target - f.constant;
+            for (const auto& [v, a] : f.terms) {
+                if (auto c = column.find(v); c != column.end())
+                    row.emplace_back(c->second, a);
+                else
+                    b -= a * params[v];
+            }
+            for (const auto& [i, ai] : row) {
+                rhs(i, 0) += ai * b;
+                for (const auto& [k, ak] : row) normal(i, k) += ai * ak;
+            }
+        }
+    }
+    // Every free variable is an entry of its own (a row of A with one 1), so A^T A is invertible.
+    const auto x = num::solve(normal, rhs);
+    std::vector<Rational> out(n);
+    for (std::size_t k = 0; k < n; ++k) {
+        const mpq_class scaled = (x ? (*x)(k, 0).value() : mpq_class(0)) * 64 + mpq_class(1, 2);
+        mpz_class whole;
+        mpz_fdiv_q(whole.get_mpz_t(), scaled.get_num_mpz_t(), scaled.get_den_mpz_t());
+        out[k] = Rational(mpq_class(whole, 64));
+    }
+    return out;
+}
+
+std::string BcifsSolution::print_entry(const AffineForm& f) const {
+    std::string s;
+    if (!f.constant.is_zero() || f.terms.empty()) s = f.constant.to_string();
+    for (const auto& [v, a] : f.terms) {
+        const std::string& name = variable_names[v];
+        const Rational m = a.sign() < 0 ? -a : a;
+        std::string term;
+        if (m.is_integer())
+            term = m == Rational(1) ? name : fmt::format("{}*{}", m.to_string(), name);
+        else if (m.numerator() == 1)
+            term = fmt::format("{}/{}", name, m.denominator().get_str());
+        else
+            term = fmt::format("{}*{}/{}", m.numerator().get_str(), name, m.denominator().get_str());
+        if (s.empty())
+            s = a.sign() < 0 ? "-" + term : term;
+        else
+            s += (a.sign() < 0 ? " - " : " + ") + term;
+    }
+    return s;
+}
+
+std::string print_bcifs_solution(const BcifsSystem& sys, const BcifsSolution& sol) {
+    std::string out = fmt::format("bcifs {}: {} unknown entries, {} equations of rank {}, {} free\n",
+                                  sys.name, sol.unknowns, sol.equations, sol.rank, sol.free.size());
+    for (std::size_t j = 0; j < sys.operators.size(); ++j) {
+        const auto& op = sys.operators[j];
+        std::vector<std::string> rows;
+        for (std::size_t r = 0; r < op.rows; ++r) {
+            std::vector<std::string> row;
+            for (std::size_t c = 0; c < op.cols; ++c)
+                row.push_back(sol.print_entry(sol.entries[j][r * op.cols + c]));
+            rows.push_back(fmt::format("[{}]", fmt::join(row, ", ")));
+        }
+        out += fmt::format("  {}.{} = [{}]\n", op.cell, op.name, fmt::join(rows, ", "));
+    }
+    std::vector<std::string> dof;
+    for (std::size_t c = 0; c < sys.cells.size(); ++c)
+        dof.push_back(fmt::format("{} {}", sys.cells[c], sol.dof[c]));
+    out += fmt::format("  degrees of freedom: {}\n", fmt::join(dof, ", "));
+    return out;
+}
+
+} // namespace frac::front

@@ -1,0 +1,214 @@
+#include "frontend/topology.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <vector>
+
+namespace frac::front {
+
+namespace {
+
+ExprPtr number(int v, Location loc) {
+    auto e = std::make_unique<Expr>();
+    e->kind = ExprKind::number;
+    e->text = std::to_string(v);
+    e->loc = loc;
+    return e;
+}
+
+// A rows x cols 0/1 matrix with a 1 at (ones[c], c) for every column c.
+ExprPtr selection(std::size_t rows, const std::vector<std::size_t>& ones, Location loc) {
+    auto m = std::make_unique<Expr>();
+    m->kind = ExprKind::matrix;
+    m->loc = loc;
+    for (std::size_t r = 0; r < rows; ++r) {
+        auto row = std::make_unique<Expr>();
+        row->kind = ExprKind::tuple;
+        row->loc = loc;
+        for (std::size_t c = 0; c < ones.size(); ++c) row->kids.push_back(number(ones[c] == r ? 1 : 0, loc));
+        m->kids.push_back(std::move(row));
+    }
+    return m;
+}
+
+class Expander {
+public:
+    Expander(AutomatonDecl& a, Diagnostics& d) : a_(a), b_(*a.bcifs), d_(d) {}
+
+    void run() {
+        for (const TopologyDecl& t : std::vector<TopologyDecl>(b_.topologies)) {
+            const std::size_t errors = d_.error_count();
+            const StateDecl* cell = find_cell(t.cell, t.loc);
+            const StateDecl* of = find_cell(t.of, t.of_loc);
+            if (!cell || !of || d_.error_count() != errors) continue;
+            origin_ = fmt::format("topology {} = {}({}) split {}", t.cell, t.kind, t.of,
+                                  t.kind == "quad" ? fmt::format("{} x {}", t.n, t.m) : std::to_string(t.n));
+            if (t.kind == "edge")
+                edge(t, *cell, *of);
+            else
+                quad(t, *cell, *of);
+        }
+    }
+
+private:
+    const StateDecl* find_cell(const std::string& name, Location loc) {
+        for (const StateDecl& s : a_.states)
+            if (s.name == name) return &s;
+        d_.error(loc, fmt::format("'{}' is no cell of this bcifs (a topology names cells declared before it)",
+                                  name));
+        return nullptr;
+    }
+
+    bool has(const std::string& cell, const std::string& name) const {
+        return std::any_of(b_.operators.begin(), b_.operators.end(),
+                           [&](const OperatorDecl& o) { return o.cell == cell && o.name == name; });
+    }
+
+    // Adds cell.name unless the model wrote it; value null: unknown.
+    void op(const TopologyDecl& t, const std::string& cell, const std::string& name,
+            const std::string& target, bool boundary, ExprPtr value) {
+        if (has(cell, name)) return;
+        OperatorDecl o;
+        o.cell = cell;
+        o.name = name;
+        o.target = target;
+        o.boundary = boundary;
+        o.loc = o.target_loc = t.loc;
+        o.value = std::move(value);
+        o.generated = true;
+        b_.operators.push_back(std::move(o));
+    }
+
+    FactorDecl factor(const std::string& cell, const std::string& name, Location loc) const {
+        FactorDecl f;
+        f.cell = cell;
+        f.name = name;
+        f.loc = loc;
+        return f;
+    }
+
+    // left1 * left2 == right1 * right2, each an operator cell.name.
+    void constraint(const TopologyDecl& t, std::pair<std::string, std::string> l1,
+                    std::pair<std::string, std::string> l2, std::pair<std::string, std::string> r1,
+                    std::pair<std::string, std::string> r2) {
+        ConstraintDecl c;
+        c.loc = t.loc;
+        c.origin = origin_;
+        c.left.push_back(factor(l1.first, l1.second, t.loc));
+        c.left.push_back(factor(l2.first, l2.second, t.loc));
+        c.right.push_back(factor(r1.first, r1.second, t.loc));
+        c.right.push_back(factor(r2.first, r2.second, t.loc));
+        b_.constraints.push_back(std::move(c));
+    }
+
+    static std::string T(int i) { return fmt::format("T{}", i); }
+
+    void edge(const TopologyDecl& t, const StateDecl& e, const StateDecl& v) {
+        if (!e.space.barycentric || e.space.n < 2 || !v.space.barycentric || v.space.n != 1) {
+            d_.error(t.loc,
+                     fmt::format("edge(v): the edge is a cell of bary(k), k >= 2, and its vertex a cell of "
+                                 "bary(1); here {} and {}",
+                                 space(e.space), space(v.space)));
+            return;
+        }
+        const std::size_t k = static_cast<std::size_t>(e.space.n);
+        op(t, v.name, "T0", v.name, false, selection(1, {0}, t.loc));
+        op(t, e.name, "B0", v.name, true, selection(k, {0}, t.loc));
+        op(t, e.name, "B1", v.name, true, selection(k, {k - 1}, t.loc));
+        for (int i = 0; i < t.n; ++i) op(t, e.name, T(i), e.name, false, nullptr);
+        constraint(t, {e.name, "B0"}, {v.name, "T0"}, {e.name, "T0"}, {e.name, "B0"});
+        constraint(t, {e.name, "B1"}, {v.name, "T0"}, {e.name, T(t.n - 1)}, {e.name, "B1"});
+        for (int i = 0; i + 1 < t.n; ++i)
+            constraint(t, {e.name, T(i)}, {e.name, "B1"}, {e.name, T(i + 1)}, {e.name, "B0"});
+    }
+
+    void quad(const TopologyDecl& t, const StateDecl& f, const StateDecl& e) {
+        const int k = e.space.n;
+        if (!e.space.barycentric || !f.space.barycentric || f.space.n != k * k) {
+            d_.error(t.loc,
+                     fmt::format("quad(e): the patch is a cell of bary(k * k) over an edge cell of bary(k); "
+                                 "here {} over {}",
+                                 space(f.space), space(e.space)));
+            return;
+        }
+        if (t.n != t.m) {
+            d_.error(t.loc,
+                     fmt::format("quad(e) split {} x {}: both sides are the one edge cell '{}', so they "
+                                 "split alike (n x n)",
+                                 t.n, t.m, e.name));
+            return;
+        }
+        for (int i = 0; i < t.n; ++i)
+            if (!has(e.name, T(i))) {
+                d_.error(t.loc,
+                         fmt::format("quad({}) split {} x {} needs the edge's operators {}.T0 ... {}.T{} (a "
+                                     "topology {} = edge(...) split {} before it)",
+                                     e.name, t.n, t.n, e.name, e.name, t.n - 1, e.name, t.n));
+                return;
+            }
+        const auto side = [&](int first, int step) {
+            std::vector<std::size_t> ones;
+            for (int p = 0; p < k; ++p) ones.push_back(static_cast<std::size_t>(first + p * step));
+            return selection(static_cast<std::size_t>(k * k), ones, t.loc);
+        };
+        op(t, f.name, "B0", e.name, true, side(0, 1));           // bottom row
+        op(t, f.name, "B1", e.name, true, side(0, k));           // left column
+        op(t, f.name, "B2", e.name, true, side(k - 1, k));       // right column
+        op(t, f.name, "B3", e.name, true, side(k * (k - 1), 1)); // top row
+        const int n = t.n;
+        const auto sub = [&](int i, int j) { return T(i + n * j); };
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) op(t, f.name, sub(i, j), f.name, false, nullptr);
+        for (int i = 0; i < n; ++i) {
+            constraint(t, {f.name, "B0"}, {e.name, T(i)}, {f.name, sub(i, 0)}, {f.name, "B0"});
+            constraint(t, {f.name, "B3"}, {e.name, T(i)}, {f.name, sub(i, n - 1)}, {f.name, "B3"});
+            constraint(t, {f.name, "B1"}, {e.name, T(i)}, {f.name, sub(0, i)}, {f.name, "B1"});
+            constraint(t, {f.name, "B2"}, {e.name, T(i)}, {f.name, sub(n - 1, i)}, {f.name, "B2"});
+        }
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                if (i + 1 < n)
+                    constraint(t, {f.name, sub(i, j)}, {f.name, "B2"}, {f.name, sub(i + 1, j)},
+                               {f.name, "B1"});
+                if (j + 1 < n)
+                    constraint(t, {f.name, sub(i, j)}, {f.name, "B3"}, {f.name, sub(i, j + 1)},
+                               {f.name, "B0"});
+            }
+    }
+
+    static std::string space(const SpaceDecl& s) {
+        return s.barycentric ? fmt::format("bary({})", s.n) : fmt::format("R{}", s.n);
+    }
+
+    AutomatonDecl& a_;
+    BcifsDecl& b_;
+    Diagnostics& d_;
+    std::string origin_;
+};
+
+} // namespace
+
+void expand_topology(Program& program, Diagnostics& diags) {
+    for (Item& it : program.items)
+        if (it.automaton && it.automaton->bcifs) Expander(*it.automaton, diags).run();
+}
+
+std::string print_constraints(const Program& program, std::uint32_t file) {
+    std::string out;
+    for (const Item& it : program.items) {
+        if (!it.automaton || !it.automaton->bcifs || it.loc.file != file) continue;
+        const BcifsDecl& b = *it.automaton->bcifs;
+        out += fmt::format("bcifs {}\n", it.name);
+        for (const OperatorDecl& o : b.operators)
+            out += fmt::format("  {} {}.{} {} {} = {}{}\n", o.boundary ? "boundary" : "subdivide", o.cell,
+                               o.name, o.boundary ? "from" : "->", o.target,
+                               o.value ? print_expr(*o.value) : "?", o.generated ? "  (generated)" : "");
+        for (const ConstraintDecl& c : b.constraints)
+            out += fmt::format("  {} == {}{}\n", print_product(c.left), print_product(c.right),
+                               c.origin.empty() ? "" : "  (" + c.origin + ")");
+    }
+    return out;
+}
+
+} // namespace frac::front

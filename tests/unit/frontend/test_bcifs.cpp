@@ -1,0 +1,120 @@
+// The bcifs constraint solver end to end: every constraint a model writes or a topology declaration
+// generates holds exactly on the operators the compiler lowers (with the values it gave the free entries),
+// so sub-patches share their boundaries exactly; seed 002's edge comes out in the paper's form.
+#include "compile.hpp"
+
+#include "frontend/ast.hpp"
+#include "ir/automaton.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace frac;
+using num::Matrix;
+using num::Rational;
+
+namespace {
+
+const ir::Arc& operator_named(const ir::Automaton& a, const std::string& cell, const std::string& name) {
+    for (const auto* list : {&a.arcs, &a.embeddings})
+        for (const ir::Arc& arc : *list)
+            if (a.states[arc.from].name == cell && arc.label == name) return arc;
+    FAIL("no operator " << cell << "." << name);
+    throw std::logic_error("unreachable");
+}
+
+// The product of a side whose factors are all operators; nullopt when one is a constant matrix.
+std::optional<Matrix<Rational>> product(const ir::Automaton& a, const std::vector<front::FactorDecl>& side) {
+    std::optional<Matrix<Rational>> p;
+    for (const front::FactorDecl& f : side) {
+        if (f.constant) return std::nullopt;
+        const ir::Arc& arc = operator_named(a, f.cell, f.name);
+        REQUIRE(arc.op.exact);
+        p = p ? *p * *arc.op.exact : *arc.op.exact;
+    }
+    return p;
+}
+
+// Checks every constraint of every bcifs of the compilation; returns how many were checked.
+int check_constraints(const front::Compilation& c) {
+    int checked = 0;
+    for (const front::Item& it : c.program.items) {
+        if (!it.automaton || !it.automaton->bcifs) continue;
+        const front::AutomatonInfo* info = c.module.find_automaton(it.name);
+        REQUIRE(info);
+        for (const front::ConstraintDecl& k : it.automaton->bcifs->constraints) {
+            const auto left = product(info->automaton, k.left), right = product(info->automaton, k.right);
+            if (!left || !right) continue;
+            INFO(it.name << ": " << front::print_product(k.left) << " == " << front::print_product(k.right));
+            CHECK(*left == *right);
+            ++checked;
+        }
+    }
+    return checked;
+}
+
+} // namespace
+
+TEST_CASE("every constraint of the library's bcifs holds exactly on the lowered operators", "[bcifs]") {
+    auto c = test::compile_ok("import \"bcifs\";");
+    // fractal_edge 3, quad_patch 3 + 12, bezier_patch 3 + 12, c1_edge 5 of 6 (one has a constant factor).
+    CHECK(check_constraints(*c) == 38);
+}
+
+TEST_CASE("a patch split 3 x 3 over an edge split 3 shares every side exactly", "[bcifs]") {
+    auto c = test::compile_ok(R"(
+bcifs patch3 {
+  cell v in bary(1);
+  cell e in bary(4);
+  cell f in bary(16);
+  topology e = edge(v) split 3;
+  topology f = quad(e) split 3 x 3;
+  project = controls((0,0,0), (1,0,1), (2,0,1), (3,0,0), (0,1,1), (1,1,2), (2,1,2), (3,1,1),
+                     (0,2,1), (1,2,2), (2,2,2), (3,2,1), (0,3,0), (1,3,1), (2,3,1), (3,3,0));
+}
+)");
+    // edge: 2 incidence + 2 adjacency; patch: 4 x 3 incidence + 2 x 3 x 2 adjacency.
+    CHECK(check_constraints(*c) == 4 + 12 + 12);
+    const ir::Automaton& a = c->module.find_automaton("patch3")->automaton;
+    CHECK(a.arcs.size() == 1 + 3 + 9);
+    CHECK(a.embeddings.size() == 2 + 4);
+}
+
+TEST_CASE("seed 002's edge: the free entries are the paper's, the rest follow exactly", "[bcifs]") {
+    auto c = test::compile_ok(R"(
+bcifs edge {
+  cell v in bary(1);
+  cell e in bary(3);
+  topology e = edge(v) split 2;
+  fix e.T0[0][1] = 1/2; fix e.T0[1][1] = 1/4; fix e.T0[0][2] = 1/8;
+  fix e.T0[1][2] = 3/8; fix e.T1[0][1] = 1/16; fix e.T1[1][1] = 5/16;
+  project = controls((0, 0), (1, 1), (2, 0));
+}
+)");
+    const ir::Automaton& a = c->module.find_automaton("edge")->automaton;
+    const Rational h(1, 2), q(1, 4), e(1, 8), t(3, 8), s(1, 16), f(5, 16);
+    CHECK(*operator_named(a, "e", "T0").op.exact ==
+          Matrix<Rational>{{1, h, e}, {0, q, t}, {0, Rational(1) - h - q, Rational(1) - e - t}});
+    CHECK(*operator_named(a, "e", "T1").op.exact ==
+          Matrix<Rational>{{e, s, 0}, {t, f, 0}, {Rational(1) - e - t, Rational(1) - s - f, 1}});
+    CHECK(c->module.find_automaton("edge")->dof == std::vector<int>{0, 0}); // all six fixed
+}
+
+TEST_CASE("bcifs errors are located and specific", "[bcifs]") {
+    const std::string cells = "cell v in bary(1); cell e in bary(3); project = controls((0, 0), (1, 1), (2, 0)); ";
+    CHECK_THAT(test::errors_of("bcifs b { " + cells + "topology e = edge(v) split 2; fix e.T0[0][0] = 2; }"),
+               Catch::Contains("conflict") && Catch::Contains("note: fix e.T0[0][0]"));
+    CHECK_THAT(test::errors_of("bcifs b { " + cells + "topology e = quad(v) split 2 x 2; }"),
+               Catch::Contains("quad(e): the patch is a cell of bary(k * k)"));
+    CHECK_THAT(test::errors_of("bcifs b { " + cells + "subdivide e { T0 = [[1, ?], [0, ?]]; } }"),
+               Catch::Contains("so it is a 3×3 matrix; this one is 2×2"));
+    CHECK_THAT(test::errors_of("bcifs b { " + cells + "topology e = edge(v) split 2; fix e.T0[0][3] = 0; }"),
+               Catch::Contains("entry [0][3] is outside it"));
+    CHECK_THAT(
+        test::errors_of("bcifs b { " + cells +
+                        "param p = 1/2; subdivide e { T0 = [[1, p * p, 0], [0, 0, 0], [0, 1, 1]]; } }"),
+        Catch::Contains("affine in the parameters"));
+    CHECK_THAT(test::errors_of("bcifs b { " + cells +
+                               "subdivide e { T0 = [[1, sqrt(2), 0], [0, 0, 0], [0, 1, 1]]; } }"),
+               Catch::Contains("exact numbers"));
+    CHECK_THAT(test::errors_of("const m = 2 * ?;"), Catch::Contains("'?'"));
+}
