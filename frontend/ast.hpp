@@ -133,8 +133,8 @@ struct ParamDecl {
 
 // topology e = edge(v) split n;  topology f = quad(e) split n x n;  (frontend/topology.hpp)
 struct TopologyDecl {
-    std::string cell, kind, of; // kind: edge or quad; `of`: the boundary cell
-    int n = 2, m = 1;
+    std::string cell, kind, of; // kind: edge, quad or cube; `of`: the boundary cell
+    int n = 2, m = 1, l = 1;
     Location loc, kind_loc, of_loc;
 };
 

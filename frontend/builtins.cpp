@@ -28,7 +28,7 @@ constexpr Builtin builtins[] = {
     {"rotate", BuiltinKind::transform, 1, 1, Op::Const},
     {"scale", BuiltinKind::transform, 1, 3, Op::Const},
     {"shear", BuiltinKind::transform, 2, 2, Op::Const},
-    {"controls", BuiltinKind::controls, 2, 16, Op::Const},
+    {"controls", BuiltinKind::controls, 1, 64, Op::Const},
     {"tabulate", BuiltinKind::tabulate, 2, 2, Op::Const},
     {"dist", BuiltinKind::distance, 2, 2, Op::External},
     {"dof", BuiltinKind::dof, 1, 1, Op::Const},

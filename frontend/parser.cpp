@@ -354,24 +354,27 @@ private:
             const Token& kind = expect(Tok::ident, "(edge or quad)");
             t.kind = kind.text;
             t.kind_loc = kind.loc;
-            if (t.kind != "edge" && t.kind != "quad")
+            if (t.kind != "edge" && t.kind != "quad" && t.kind != "cube")
                 throw CompileError(kind.loc,
-                                   fmt::format("no topology '{}': the topologies are edge(v) split n "
-                                               "and quad(e) split n x n",
+                                   fmt::format("no topology '{}': the topologies are edge(v) split n, "
+                                               "quad(e) split n x n and cube(f) split n x n x n",
                                                t.kind));
             expect(Tok::lparen, "after the topology");
-            const Token& of = expect(Tok::ident, t.kind == "edge" ? "(the vertex cell)" : "(the edge cell)");
+            const Token& of = expect(Tok::ident, t.kind == "edge"   ? "(the vertex cell)"
+                                                 : t.kind == "quad" ? "(the edge cell)"
+                                                                    : "(the face cell)");
             t.of = of.text;
             t.of_loc = of.loc;
             expect(Tok::rparen, "after the boundary cell");
             if (!at_word("split")) fail("expected 'split' and the number of parts");
             take();
             t.n = count();
-            if (t.kind == "quad") {
+            const int axes = t.kind == "edge" ? 1 : t.kind == "quad" ? 2 : 3;
+            for (int axis = 1; axis < axes; ++axis) {
                 if (!at_word("x") && !at(Tok::times) && !at(Tok::star))
-                    fail("expected 'x' and the parts along t");
+                    fail("expected 'x' and the parts along the next axis");
                 take();
-                t.m = count();
+                (axis == 1 ? t.m : t.l) = count();
             }
             b.topologies.push_back(std::move(t));
         } else if (at_word("fix")) {

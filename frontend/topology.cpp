@@ -43,11 +43,15 @@ public:
             const StateDecl* of = find_cell(t.of, t.of_loc);
             if (!cell || !of || d_.error_count() != errors) continue;
             origin_ = fmt::format("topology {} = {}({}) split {}", t.cell, t.kind, t.of,
-                                  t.kind == "quad" ? fmt::format("{} x {}", t.n, t.m) : std::to_string(t.n));
+                                  t.kind == "cube"   ? fmt::format("{} x {} x {}", t.n, t.m, t.l)
+                                  : t.kind == "quad" ? fmt::format("{} x {}", t.n, t.m)
+                                                     : std::to_string(t.n));
             if (t.kind == "edge")
                 edge(t, *cell, *of);
-            else
+            else if (t.kind == "quad")
                 quad(t, *cell, *of);
+            else
+                cube(t, *cell, *of);
         }
     }
 
@@ -175,6 +179,93 @@ private:
                     constraint(t, {f.name, sub(i, j)}, {f.name, "B3"}, {f.name, sub(i, j + 1)},
                                {f.name, "B0"});
             }
+    }
+
+    // c in bary(k^3) over the face cell f (bary(k^2), split n x n): control point p[k^2 z + k y + x];
+    // faces B0 z = 0, B1 z = k-1, B2 y = 0, B3 y = k-1, B4 x = 0, B5 x = k-1, each face's (s, t) the two
+    // other axes in increasing order (x, y), (x, z), (y, z), so faces agree along the cube's edges;
+    // sub-cube T(i + n j + n^2 l) at (x, y, z) = (i, j, l).
+    void cube(const TopologyDecl& t, const StateDecl& c, const StateDecl& f) {
+        int k = 1;
+        while (k * k < f.space.n) ++k;
+        if (!c.space.barycentric || !f.space.barycentric || k * k != f.space.n || c.space.n != k * k * k) {
+            d_.error(t.loc,
+                     fmt::format("cube(f): the volume is a cell of bary(k^3) over a face cell of bary(k^2); "
+                                 "here {} over {}",
+                                 space(c.space), space(f.space)));
+            return;
+        }
+        const int n = t.n;
+        if (t.m != n || t.l != n) {
+            d_.error(t.loc,
+                     fmt::format("cube(f) split {} x {} x {}: every face is the one cell '{}', so all axes "
+                                 "split alike (n x n x n)",
+                                 t.n, t.m, t.l, f.name));
+            return;
+        }
+        for (int i = 0; i < n * n; ++i)
+            if (!has(f.name, T(i))) {
+                d_.error(t.loc,
+                         fmt::format("cube({}) split {} needs the face's operators {}.T0 ... {}.T{} (a "
+                                     "topology {} = quad(...) split {} x {} before it)",
+                                     f.name, n, f.name, f.name, n * n - 1, f.name, n, n));
+                return;
+            }
+        // Face a (0: z, 1: y, 2: x) at side 0 or k-1: its axes (s, t) in increasing order.
+        struct Face {
+            int normal, side;
+        };
+        const std::vector<Face> faces = {{2, 0}, {2, 1}, {1, 0}, {1, 1}, {0, 0}, {0, 1}};
+        const auto axes = [](int normal) {
+            return normal == 2 ? std::pair{0, 1} : normal == 1 ? std::pair{0, 2} : std::pair{1, 2};
+        };
+        const auto point = [&](int x, int y, int z) {
+            return static_cast<std::size_t>(k * k * z + k * y + x);
+        };
+        for (std::size_t b = 0; b < faces.size(); ++b) {
+            const auto [sa, ta] = axes(faces[b].normal);
+            std::vector<std::size_t> ones;
+            for (int row = 0; row < k; ++row)
+                for (int col = 0; col < k; ++col) {
+                    int xyz[3];
+                    xyz[faces[b].normal] = faces[b].side ? k - 1 : 0;
+                    xyz[sa] = col;
+                    xyz[ta] = row;
+                    ones.push_back(point(xyz[0], xyz[1], xyz[2]));
+                }
+            op(t, c.name, fmt::format("B{}", b), f.name, true,
+               selection(static_cast<std::size_t>(k * k * k), ones, t.loc));
+        }
+        const auto sub = [&](int x, int y, int z) { return T(x + n * y + n * n * z); };
+        for (int z = 0; z < n; ++z)
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x) op(t, c.name, sub(x, y, z), c.name, false, nullptr);
+        for (std::size_t b = 0; b < faces.size(); ++b) {
+            const auto [sa, ta] = axes(faces[b].normal);
+            const std::string B = fmt::format("B{}", b);
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i) {
+                    int xyz[3];
+                    xyz[faces[b].normal] = faces[b].side ? n - 1 : 0;
+                    xyz[sa] = i;
+                    xyz[ta] = j;
+                    constraint(t, {c.name, B}, {f.name, T(i + n * j)}, {c.name, sub(xyz[0], xyz[1], xyz[2])},
+                               {c.name, B});
+                }
+        }
+        for (int z = 0; z < n; ++z)
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x) {
+                    if (x + 1 < n)
+                        constraint(t, {c.name, sub(x, y, z)}, {c.name, "B5"}, {c.name, sub(x + 1, y, z)},
+                                   {c.name, "B4"});
+                    if (y + 1 < n)
+                        constraint(t, {c.name, sub(x, y, z)}, {c.name, "B3"}, {c.name, sub(x, y + 1, z)},
+                                   {c.name, "B2"});
+                    if (z + 1 < n)
+                        constraint(t, {c.name, sub(x, y, z)}, {c.name, "B1"}, {c.name, sub(x, y, z + 1)},
+                                   {c.name, "B0"});
+                }
     }
 
     static std::string space(const SpaceDecl& s) {

@@ -11,6 +11,9 @@
 //       right column, B3 the top row (each from its first to its last point); sub-patch T(i + n j) is the
 //       i-th along s and the j-th along t (T0 bottom left); incidence: each boundary's pieces are the
 //       sub-patches along it; adjacency: neighbours share their common side.
+//   topology c = cube(f) split n x n x n;  c in bary(k^3) over the face cell f (bary(k^2), split n x n):
+//       six faces B0 ... B5 (z low, z high, y low, y high, x low, x high), n^3 sub-cubes, incidence on
+//       every face, adjacency between neighbours along each axis.
 //
 // Operators the model writes itself are kept (a partly known T0, a different B0); only missing ones are
 // generated. The pass runs after parsing (the `constraints` stage), before names are resolved.

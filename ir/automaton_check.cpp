@@ -216,6 +216,51 @@ std::vector<int> strongly_connected_components(const Automaton& a, const std::ve
     return comp;
 }
 
+// The induced 1-norm (largest column sum of magnitudes) or max-norm (largest row sum), rounded up.
+// The operator norm, rounded up, of a linear part L (direction coordinates, see direction_basis) when
+// every space's directions carry the 1-norm of their full coordinates: for bary(n) the zero-sum
+// weights x = (y, -sum y), |x|_1 = |y|_1 + |sum y|. The extreme points of a unit ball are +-e_j
+// (euclidean) or (e_j - e_k) / 2 (barycentric), so the norm is the largest image norm among them
+// (for bary, Dobrushin's ergodicity coefficient of the full matrix).
+static double zero_sum_l1_upper(const Matrix<Interval>& m, bool target_bary, bool source_bary) {
+    const num::UpwardRounding up;
+    const auto image_norm = [&](std::size_t j, std::optional<std::size_t> k) { // |L e_j - L e_k|
+        double sum = 0;
+        Interval total(0.0);
+        for (std::size_t r = 0; r < m.rows(); ++r) {
+            const Interval v = k ? num::sub(m(r, j), m(r, *k)) : m(r, j);
+            sum = num::add(Interval(sum), Interval(num::magnitude(v))).hi;
+            total = num::add(total, v);
+        }
+        return target_bary ? num::add(Interval(sum), Interval(num::magnitude(total))).hi : sum;
+    };
+    double best = 0;
+    for (std::size_t j = 0; j < m.cols(); ++j) {
+        if (!source_bary) {
+            best = std::max(best, image_norm(j, std::nullopt));
+            continue;
+        }
+        // e_j - e_n has coordinates e_j; e_j - e_k (k < n) has e_j - e_k; each of 1-norm 2.
+        best = std::max(best, num::mul(Interval(image_norm(j, std::nullopt)), Interval(0.5)).hi);
+        for (std::size_t k = j + 1; k < m.cols(); ++k)
+            best = std::max(best, num::mul(Interval(image_norm(j, k)), Interval(0.5)).hi);
+    }
+    return best;
+}
+
+static double induced_norm_upper(const Matrix<Interval>& m, bool rows) {
+    const num::UpwardRounding up;
+    double best = 0;
+    const std::size_t outer = rows ? m.rows() : m.cols(), inner = rows ? m.cols() : m.rows();
+    for (std::size_t i = 0; i < outer; ++i) {
+        double sum = 0;
+        for (std::size_t j = 0; j < inner; ++j)
+            sum = num::add(Interval(sum), Interval(num::magnitude(rows ? m(i, j) : m(j, i)))).hi;
+        best = std::max(best, sum);
+    }
+    return best;
+}
+
 double norm2_upper(const Matrix<Interval>& m) {
     if (m.rows() == 0 || m.cols() == 0) return 0;
     const Matrix<Interval> g = num::transpose(m) * m; // outward rounded
@@ -279,15 +324,27 @@ ContractivityResult prove_contractive(const Automaton& a, const ContractivityOpt
             (static_cast<double>(products) + total) * cube > options.max_work)
             break;
         products += static_cast<std::size_t>(total);
-        // M_L[a][b]: the largest bound over the paths a -> ... -> b of this length.
-        Matrix<Interval> m(n, n);
+        // M_L[a][b]: the largest bound over the paths a -> ... -> b of this length, in each of four
+        // norm families (every state's direction coordinates with the 2-norm, the 1-norm or the max-norm,
+        // or its full coordinates with the 1-norm): a family is one norm per state, so its products
+        // bound composites; the proof takes whichever family gives the smaller spectral radius.
+        Matrix<Interval> family[4] = {Matrix<Interval>(n, n), Matrix<Interval>(n, n), Matrix<Interval>(n, n),
+                                      Matrix<Interval>(n, n)};
         std::vector<Matrix<Interval>> prefix(static_cast<std::size_t>(length) + 1);
         std::function<void(std::size_t, std::size_t, int)> walk = [&](std::size_t start, std::size_t s,
                                                                       int depth) {
             if (depth == length) {
-                const double bound = norm2_upper(prefix[static_cast<std::size_t>(depth)]);
-                const double v = std::max(m(start, s).hi, bound);
-                m(start, s) = Interval(v, v);
+                const Matrix<Interval>& p = prefix[static_cast<std::size_t>(depth)];
+                const auto bary = [&](std::size_t state) {
+                    return a.states[state].space.kind == Space::Kind::barycentric;
+                };
+                const double bounds[std::size(family)] = {norm2_upper(p), induced_norm_upper(p, false),
+                                                          induced_norm_upper(p, true),
+                                                          zero_sum_l1_upper(p, bary(start), bary(s))};
+                for (std::size_t f = 0; f < std::size(family); ++f) {
+                    const double v = std::max(family[f](start, s).hi, bounds[f]);
+                    family[f](start, s) = Interval(v, v);
+                }
                 return;
             }
             for (std::size_t i : out[s]) {
@@ -299,15 +356,19 @@ ContractivityResult prove_contractive(const Automaton& a, const ContractivityOpt
         for (std::size_t s = 0; s < n; ++s)
             if (live[s]) walk(s, s, 0);
         // rho(M_L) is the largest over the diagonal blocks of the strongly connected components.
-        double rho = 0;
-        for (int c = 0; c < components; ++c) {
-            std::vector<std::size_t> members;
-            for (std::size_t s = 0; s < n; ++s)
-                if (comp[s] == c) members.push_back(s);
-            Matrix<Interval> block(members.size(), members.size());
-            for (std::size_t i = 0; i < members.size(); ++i)
-                for (std::size_t j = 0; j < members.size(); ++j) block(i, j) = m(members[i], members[j]);
-            rho = std::max(rho, spectral_radius_bracket(block).hi);
+        double rho = num::inf;
+        for (const Matrix<Interval>& m : family) {
+            double family_rho = 0;
+            for (int c = 0; c < components; ++c) {
+                std::vector<std::size_t> members;
+                for (std::size_t s = 0; s < n; ++s)
+                    if (comp[s] == c) members.push_back(s);
+                Matrix<Interval> block(members.size(), members.size());
+                for (std::size_t i = 0; i < members.size(); ++i)
+                    for (std::size_t j = 0; j < members.size(); ++j) block(i, j) = m(members[i], members[j]);
+                family_rho = std::max(family_rho, spectral_radius_bracket(block).hi);
+            }
+            rho = std::min(rho, family_rho);
         }
         best_bound = std::min(best_bound, rho);
         tried = length;

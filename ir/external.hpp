@@ -6,7 +6,10 @@
 
 #include "numeric/interval.hpp"
 
+#include <cstdint>
+#include <optional>
 #include <string>
+#include <vector>
 
 namespace frac::ir {
 
@@ -21,6 +24,26 @@ public:
     virtual double eval_point(const double* args) const = 0;
     // For printers and messages ("dist sierpinski").
     virtual std::string name() const = 0;
+
+    // How a compiled model (frac compile) carries the function: it cannot hold a pointer into this
+    // process, so it embeds `data` and, at its first call, asks the C function `resolve` of the run-time
+    // archive `archive` (a file next to the frac binary) to rebuild the function from it; `release`
+    // frees that when the model is unloaded. Both take an ExternalData*. nullopt: not compilable.
+    struct Compiled {
+        std::string archive;          // "libfrac_aot_automata.a"
+        std::string resolve, release; // C symbols in the archive
+        std::vector<std::uint8_t> data;
+    };
+    virtual std::optional<Compiled> compiled() const { return std::nullopt; }
+};
+
+// A compiled model's record of one external function, laid out as the generated code emits it
+// (backend/llvm/aot.cpp): the function rebuilt from the data (null until the first call; written
+// once, with atomic_ref), and the embedded data.
+struct ExternalData {
+    const ExternalFunction* function;
+    std::uint64_t size;
+    const std::uint8_t* data;
 };
 
 } // namespace frac::ir

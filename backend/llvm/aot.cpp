@@ -6,6 +6,7 @@
 #include "backend/llvm/jit.hpp"
 #include "backend/llvm/pipeline.hpp"
 #include "backend/llvm/tables.hpp"
+#include "ir/external.hpp"
 
 #include <llvm/IR/Constants.h>
 #include <llvm/IR/DerivedTypes.h>
@@ -25,8 +26,11 @@
 #include <llvm/TargetParser/Host.h>
 #include <llvm/TargetParser/SubtargetFeature.h>
 #include <llvm/TargetParser/Triple.h>
+#include <llvm/Transforms/Utils/ModuleUtils.h>
 
+#include <algorithm>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -148,6 +152,70 @@ void add_wrappers(llvm::Module& m, const AotShape& shape, const AotConfig& confi
     }
 }
 
+// The external functions a shape calls (by their index in its tape) in the form compiled models carry.
+std::map<std::int64_t, ir::ExternalFunction::Compiled> compiled_externals(const AotShape& s) {
+    std::map<std::int64_t, ir::ExternalFunction::Compiled> out;
+    for (const auto& block : s.tape.blocks)
+        for (const ir::Instr& ins : block) {
+            if (ins.op != ir::Op::External || out.contains(ins.imm)) continue;
+            const auto k = static_cast<std::size_t>(ins.imm);
+            const ir::ExternalFunction* f = k < s.tape.externals.size() ? s.tape.externals[k].get() : nullptr;
+            if (!f) throw std::logic_error("aot: external function #" + std::to_string(k) + " is not bound");
+            std::optional<ir::ExternalFunction::Compiled> c = f->compiled();
+            if (!c)
+                throw std::invalid_argument("shape '" + s.name + "' calls " + f->name() +
+                                            ", which compiled models cannot carry");
+            out.emplace(ins.imm, std::move(*c));
+        }
+    return out;
+}
+
+// The record of external function k (an ir::ExternalData over the embedded data) and the getter the
+// generated code calls (codegen.hpp): resolve(record), which rebuilds the function at the first call.
+llvm::GlobalVariable* add_external_getter(llvm::Module& m, const std::string& name, std::int64_t k,
+                                          const ir::ExternalFunction::Compiled& c) {
+    llvm::LLVMContext& ctx = m.getContext();
+    auto* ptr = llvm::PointerType::get(ctx, 0);
+    auto* i64 = llvm::Type::getInt64Ty(ctx);
+    const std::string getter = external_getter(name, k);
+    auto* bytes = llvm::ConstantDataArray::get(ctx, llvm::ArrayRef<std::uint8_t>(c.data));
+    auto* data = new llvm::GlobalVariable(m, bytes->getType(), true, llvm::GlobalValue::PrivateLinkage, bytes,
+                                          getter + ".data");
+    auto* record_type = llvm::StructType::get(ctx, {ptr, i64, ptr});
+    auto* record = new llvm::GlobalVariable(
+        m, record_type, false, llvm::GlobalValue::InternalLinkage,
+        llvm::ConstantStruct::get(record_type, {llvm::ConstantPointerNull::get(ptr),
+                                                llvm::ConstantInt::get(i64, c.data.size()), data}),
+        getter + ".record");
+    record->setAlignment(llvm::Align(8)); // its first word is accessed atomically
+    auto* f = llvm::Function::Create(llvm::FunctionType::get(ptr, {}, false),
+                                     llvm::GlobalValue::InternalLinkage, getter, m);
+    f->setDoesNotThrow();
+    llvm::IRBuilder<> b(llvm::BasicBlock::Create(ctx, "entry", f));
+    llvm::FunctionCallee resolve =
+        m.getOrInsertFunction(c.resolve, llvm::FunctionType::get(ptr, {ptr}, false));
+    llvm::cast<llvm::Function>(resolve.getCallee())->setDoesNotThrow();
+    b.CreateRet(b.CreateCall(resolve, {record}));
+    return record;
+}
+
+// A destructor of the model (run when a library is unloaded or a program exits) that frees what the
+// resolvers built.
+void add_releases(llvm::Module& m,
+                  const std::vector<std::pair<llvm::GlobalVariable*, std::string>>& releases) {
+    if (releases.empty()) return;
+    llvm::LLVMContext& ctx = m.getContext();
+    auto* ptr = llvm::PointerType::get(ctx, 0);
+    auto* vd = llvm::Type::getVoidTy(ctx);
+    auto* f = llvm::Function::Create(llvm::FunctionType::get(vd, {}, false),
+                                     llvm::GlobalValue::InternalLinkage, "frac_aot.release_externals", m);
+    llvm::IRBuilder<> b(llvm::BasicBlock::Create(ctx, "entry", f));
+    for (const auto& [record, release] : releases)
+        b.CreateCall(m.getOrInsertFunction(release, llvm::FunctionType::get(vd, {ptr}, false)), {record});
+    b.CreateRetVoid();
+    llvm::appendToGlobalDtors(m, f, 0);
+}
+
 void write_file(const std::string& path, llvm::sys::fs::OpenFlags flags,
                 const std::function<void(llvm::raw_fd_ostream&)>& write) {
     std::error_code ec;
@@ -164,16 +232,19 @@ void write_file(const std::string& path, llvm::sys::fs::OpenFlags flags,
 
 } // namespace
 
+std::vector<std::string> external_archives(const std::vector<AotShape>& shapes) {
+    std::vector<std::string> out;
+    for (const AotShape& s : shapes)
+        for (const auto& [k, c] : compiled_externals(s))
+            if (std::find(out.begin(), out.end(), c.archive) == out.end()) out.push_back(c.archive);
+    return out;
+}
+
 AotInfo compile_aot(const std::vector<AotShape>& shapes, const AotConfig& config,
                     const std::string& object_path, const std::string& llvm_ir_path) {
     for (const AotShape& s : shapes) {
         check_options(s.tape, config.options);
-        for (const auto& block : s.tape.blocks)
-            for (const ir::Instr& ins : block)
-                if (ins.op == ir::Op::External)
-                    throw std::invalid_argument(
-                        "shape '" + s.name +
-                        "' calls dist(...), which needs the runtime: not available in compiled models");
+        compiled_externals(s); // throws for a function compiled models cannot carry
         if (!is_c_identifier(config.prefix + s.name))
             throw std::invalid_argument("'" + config.prefix + s.name + "' is not a C identifier");
         if (static_cast<int>(s.box.size()) != s.tape.inputs)
@@ -189,12 +260,16 @@ AotInfo compile_aot(const std::vector<AotShape>& shapes, const AotConfig& config
     module.setDataLayout(target.machine->createDataLayout());
     module.setTargetTriple(target.info.triple);
     module.setPICLevel(llvm::PICLevel::BigPIC);
+    std::vector<std::pair<llvm::GlobalVariable*, std::string>> releases;
     for (const AotShape& s : shapes) {
+        for (auto& [k, c] : compiled_externals(s))
+            releases.emplace_back(add_external_getter(module, "frac_aot." + s.name, k, c), c.release);
         const Tables tables = build_tables(s.tape, config.options);
         const GeneratedNames names = generate(s.tape, config.options, tables, module, "frac_aot." + s.name,
                                               target.rounding, target.info.lanes);
         add_wrappers(module, s, config, names);
     }
+    add_releases(module, releases);
     verify_generated(module);
     optimize(module, target.machine.get());
 

@@ -3,7 +3,8 @@
 // The same code generator as the JIT (codegen.hpp) emits each shape's batch functions into one LLVM
 // module; exported C wrappers with stable names are added around them, and LLVM's TargetMachine writes
 // the object (compile_aot). The object still calls the numeric core: build_aot links it with
-// libfrac_aot_runtime.a (aot_runtime.hpp, helpers.hpp, the numeric core, LLVM libc) into a
+// libfrac_aot_runtime.a (aot_runtime.hpp, helpers.hpp, the numeric core, LLVM libc), and with the
+// archives of the external functions it calls (dist(p, A): libfrac_aot_automata.a), into a
 // self-contained object or a shared library (`frac compile`), and make_aot loads such a library into
 // this process as an evaluator (`--engine aot`, the conformance suite).
 //
@@ -55,6 +56,11 @@ bool is_c_identifier(const std::string& name);
 // std::invalid_argument for options out of range or a CPU LLVM does not know.
 AotInfo compile_aot(const std::vector<AotShape>& shapes, const AotConfig& config,
                     const std::string& object_path, const std::string& llvm_ir_path);
+
+// The run-time archives (file names) that the external functions the shapes call need besides
+// libfrac_aot_runtime.a (ir::ExternalFunction::compiled). Throws std::invalid_argument for a function
+// compiled models cannot carry.
+std::vector<std::string> external_archives(const std::vector<AotShape>& shapes);
 
 // compile_aot, then the object linked with the run-time archive into `output`: a relocatable object
 // (.o) or a shared library (.so) whose only global symbols are the exported functions (docs/c-abi.md,

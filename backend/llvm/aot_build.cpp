@@ -54,25 +54,32 @@ void run_tool(const std::vector<std::string>& args, const std::string& what) {
                        "): " + line);
 }
 
-// The run-time archive: $FRAC_AOT_RUNTIME, next to the running binary, or where the build put it.
-std::string find_runtime_archive() {
-    const char* name = "libfrac_aot_runtime.a";
+// A run-time archive of compiled models (libfrac_aot_runtime.a, or one an external function names):
+// $FRAC_AOT_RUNTIME names the first and its directory holds the others; else they lie next to the
+// running binary or where the build put them.
+std::string find_archive(const std::string& name) {
+    const fs::path build_dir = fs::path(FRAC_AOT_RUNTIME_PATH).parent_path();
+    const bool main_archive = name == fs::path(FRAC_AOT_RUNTIME_PATH).filename().string();
     std::vector<fs::path> tried;
     if (const char* env = std::getenv("FRAC_AOT_RUNTIME"); env && *env) {
-        if (fs::exists(env)) return env;
-        throw JitError(std::string("FRAC_AOT_RUNTIME names '") + env + "', which does not exist");
+        const fs::path p = main_archive ? fs::path(env) : fs::path(env).parent_path() / name;
+        if (fs::exists(p)) return p.string();
+        throw JitError(main_archive
+                           ? std::string("FRAC_AOT_RUNTIME names '") + env + "', which does not exist"
+                           : "no '" + name + "' next to FRAC_AOT_RUNTIME ('" + env + "')");
     }
     std::error_code ec;
     const fs::path self = fs::read_symlink("/proc/self/exe", ec);
     if (!ec) tried.push_back(self.parent_path() / name);
-    tried.push_back(FRAC_AOT_RUNTIME_PATH);
+    tried.push_back(build_dir / name);
     std::string list;
     for (const fs::path& p : tried) {
         if (fs::exists(p, ec)) return p.string();
         list += (list.empty() ? "" : ", ") + p.string();
     }
-    throw JitError("cannot find the run-time archive of compiled models (" + list +
-                   "); build the frac_aot_runtime target or set FRAC_AOT_RUNTIME");
+    const std::string target = fs::path(name).stem().string().substr(3); // libX.a -> X
+    throw JitError("cannot find the run-time archive " + name + " of compiled models (" + list +
+                   "); build the " + target + " target or set FRAC_AOT_RUNTIME");
 }
 
 // A fresh private directory for intermediate files, removed on scope exit.
@@ -176,14 +183,18 @@ private:
 
 AotInfo build_aot(const std::vector<AotShape>& shapes, const AotConfig& config, const std::string& output,
                   const std::string& llvm_ir_path) {
-    const std::string archive = find_runtime_archive();
+    // The external functions' archives first: their members call the run-time support.
+    std::vector<std::string> archives;
+    for (const std::string& name : external_archives(shapes)) archives.push_back(find_archive(name));
+    archives.push_back(find_archive(fs::path(FRAC_AOT_RUNTIME_PATH).filename().string()));
     TempDir tmp;
     const std::string generated = tmp.file("generated.o");
     const AotInfo info = compile_aot(shapes, config, generated, llvm_ir_path);
 
     const std::string combined = tmp.file("combined.o");
-    run_tool({tool(FRAC_AOT_LD, "ld"), "-r", "-o", combined, generated, archive},
-             "linking the run-time support into the model");
+    std::vector<std::string> link = {tool(FRAC_AOT_LD, "ld"), "-r", "-o", combined, generated};
+    link.insert(link.end(), archives.begin(), archives.end());
+    run_tool(link, "linking the run-time support into the model");
     const std::string object = ends_with(output, ".o") ? output : tmp.file("model.o");
     // Local symbols in COMDAT groups would still be merged with another model's copies (and the
     // references to the discarded copy break): the groups go, each model keeps its own code.

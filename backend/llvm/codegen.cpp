@@ -241,6 +241,10 @@ private:
 
 } // namespace
 
+std::string external_getter(const std::string& name, std::int64_t k) {
+    return name + ".external." + std::to_string(k);
+}
+
 GeneratedNames generate(const Tape& tape, const ir::EvalOptions& options, const Tables& tables,
                         llvm::Module& module, const std::string& name, Rounding rounding, int lanes) {
     GeneratedNames names;

@@ -17,6 +17,7 @@
 #include "ir/evaluator.hpp"
 #include "ir/tape.hpp"
 
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -34,6 +35,12 @@ enum class Rounding { constrained, avx512 };
 struct GeneratedNames {
     std::string box, point;
 };
+
+// The tape's external function k (Op::External) is called through a pointer: the JIT embeds the
+// address of the ir::ExternalFunction it runs with; a compiled model cannot, so its module defines,
+// before generate, a function `ptr external_getter(name, k)()` returning it (aot.cpp), which the code
+// calls instead.
+std::string external_getter(const std::string& name, std::int64_t k);
 
 // Emits both functions into `module` (whose data layout and triple the caller has set).
 GeneratedNames generate(const ir::Tape& tape, const ir::EvalOptions& options, const Tables& tables,

@@ -68,6 +68,7 @@ CInterval frac_jit_powi(double lo, double hi, std::int64_t n) noexcept {
 CInterval frac_jit_external(const void* f, double alo, double ahi, double blo, double bhi, double clo,
                             double chi) noexcept {
     const num::Interval args[3] = {{alo, ahi}, {blo, bhi}, {clo, chi}};
+    if (!f) return out(num::Interval::entire()); // a compiled model's function could not be rebuilt
     try {
         return out(static_cast<const frac::ir::ExternalFunction*>(f)->eval_box(args));
     } catch (...) {
@@ -77,6 +78,7 @@ CInterval frac_jit_external(const void* f, double alo, double ahi, double blo, d
 
 double frac_jit_external_point(const void* f, double a, double b, double c) noexcept {
     const double args[3] = {a, b, c};
+    if (!f) return std::nan("");
     try {
         return static_cast<const frac::ir::ExternalFunction*>(f)->eval_point(args);
     } catch (...) {

@@ -35,11 +35,12 @@ frac::jit::CInterval frac_jit_tan(double lo, double hi) noexcept;
 frac::jit::CInterval frac_jit_exp(double lo, double hi) noexcept;
 frac::jit::CInterval frac_jit_log(double lo, double hi) noexcept;
 frac::jit::CInterval frac_jit_powi(double lo, double hi, std::int64_t n) noexcept;
-// Op::External: the ir::ExternalFunction at `f` (a pointer the JIT embeds as a constant: in-process only)
-// over the box [alo, ahi] x [blo, bhi] x [clo, chi] (upward rounding active); entire if it throws.
+// Op::External: the ir::ExternalFunction at `f` (a pointer the JIT embeds as a constant; a compiled
+// model's getter returns it, codegen.hpp) over the box [alo, ahi] x [blo, bhi] x [clo, chi] (upward
+// rounding active); entire if it throws or `f` is null.
 frac::jit::CInterval frac_jit_external(const void* f, double alo, double ahi, double blo, double bhi,
                                        double clo, double chi) noexcept;
-// Its point value (round to nearest); NaN if it throws.
+// Its point value (round to nearest); NaN if it throws or `f` is null.
 double frac_jit_external_point(const void* f, double a, double b, double c) noexcept;
 // frac_jit_external per lane of `mask`, laid out as for frac_jit_vop (three operands).
 void frac_jit_vexternal(const void* f, const double* in, double* out, std::uint32_t mask, int lanes) noexcept;

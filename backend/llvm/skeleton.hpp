@@ -14,6 +14,7 @@
 //   V index_value(const SeriesLoop&)          the index slot's value from the index i
 #pragma once
 
+#include "backend/llvm/codegen.hpp"
 #include "backend/llvm/tables.hpp"
 #include "ir/evaluator.hpp"
 #include "ir/graph.hpp"
@@ -209,9 +210,11 @@ protected:
         return globals_[key] = g;
     }
     // A function of the helpers (helpers.hpp), which throw nothing.
-    // The address of the tape's external function k as a constant: the JIT runs in the process that
-    // owns it (the compiled code keeps the tape, hence the function, alive). AOT refuses External.
+    // The address of the tape's external function k: from the module's getter where there is one
+    // (compiled models, codegen.hpp), else as a constant: the JIT runs in the process that owns it (the
+    // compiled code keeps the tape, hence the function, alive).
     llvm::Value* external_function(std::int64_t k) {
+        if (llvm::Function* getter = m_.getFunction(external_getter(name_, k))) return b_.CreateCall(getter);
         const auto i = static_cast<std::size_t>(k);
         if (k < 0 || i >= t_.externals.size() || !t_.externals[i])
             throw std::logic_error("jit: external function #" + std::to_string(k) + " is not bound");

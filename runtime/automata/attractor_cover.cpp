@@ -70,8 +70,13 @@ namespace {
 using Key = std::uint64_t; // (iz * n + iy) * n + ix at the current level
 
 struct Grid {
-    std::vector<Interval> root; // per axis
+    std::vector<Interval> root; // per axis: 2 or 3 (states of one automaton may differ)
     std::vector<Interval> width;
+    // Whether the state lies on a cycle of the automaton's graph: its cells are kept when they are
+    // recurrent. A state on no cycle (a projected spline's initial state) holds the images of the
+    // others' attractors: its cells are kept when a kept cell maps onto them.
+    bool on_cycle = true;
+    int dimension() const { return static_cast<int>(root.size()); }
 };
 
 // A target of an image: a state and the box its cell's image lies in.
@@ -80,7 +85,8 @@ struct Image {
     std::array<Interval, 3> box;
 };
 
-// The images of many cells at once: states[i], boxes (d intervals per cell) -> appended to `out`, with
+// The images of many cells at once: states[i], boxes (as many intervals per cell as its state has
+// axes, one cell after the other) -> appended to `out`, with
 // `first[i]` the index of cell i's first image (first has one more entry).
 using ImageFn = std::function<void(const std::vector<std::size_t>& states, const std::vector<Interval>& boxes,
                                    std::vector<Image>& out, std::vector<std::size_t>& first)>;
@@ -93,13 +99,39 @@ Key key_of(std::uint64_t ix, std::uint64_t iy, std::uint64_t iz, std::uint64_t n
     return (iz * n + iy) * n + ix;
 }
 
-AttractorCoverResult build(int d, const std::vector<Grid>& grids, std::size_t initial, const ImageFn& images,
+// Keeps the recurrent vertices of states on a cycle, then every vertex of a state on no cycle that a
+// kept vertex has an arc to (breadth first: such states may feed one another).
+std::vector<bool> kept_vertices(const std::vector<std::uint64_t>& offsets,
+                                const std::vector<std::uint32_t>& targets,
+                                const std::vector<bool>& on_cycle_vertex) {
+    std::vector<bool> keep = recurrent_vertices(offsets, targets);
+    std::vector<std::uint32_t> queue;
+    for (std::size_t v = 0; v < keep.size(); ++v) {
+        if (!on_cycle_vertex[v]) keep[v] = false;
+        if (keep[v]) queue.push_back(static_cast<std::uint32_t>(v));
+    }
+    while (!queue.empty()) {
+        const std::uint32_t v = queue.back();
+        queue.pop_back();
+        for (std::uint64_t e = offsets[v]; e < offsets[v + 1]; ++e) {
+            const std::uint32_t w = targets[e];
+            if (!keep[w] && !on_cycle_vertex[w]) keep[w] = true, queue.push_back(w);
+        }
+    }
+    return keep;
+}
+
+AttractorCoverResult build(const std::vector<Grid>& grids, std::size_t initial, const ImageFn& images,
                            const AttractorCoverOptions& o) {
     if (o.initial_level < 0 || o.refinements < 0)
         throw std::invalid_argument("attractor cover: levels must not be negative");
     const int last = o.initial_level + o.refinements;
-    if (last > (d == 2 ? max_depth_2d : max_depth_3d) || last > 20)
-        throw std::invalid_argument(fmt::format("attractor cover: level {} is too deep for {}D", last, d));
+    const int d = grids[initial].dimension();
+    int deepest = d;
+    for (const Grid& g : grids) deepest = std::max(deepest, g.dimension());
+    if (last > (deepest == 2 ? max_depth_2d : max_depth_3d) || last > 20)
+        throw std::invalid_argument(
+            fmt::format("attractor cover: level {} is too deep for {}D", last, deepest));
     const std::size_t ns = grids.size();
     AttractorCoverResult out;
     out.root = grids[initial].root;
@@ -110,16 +142,18 @@ AttractorCoverResult build(int d, const std::vector<Grid>& grids, std::size_t in
 
     // The kept cells of every state, sorted keys; first every cell of the initial grid.
     std::uint64_t n = std::uint64_t(1) << o.initial_level;
-    const std::uint64_t all = d == 2 ? n * n : n * n * n;
-    if (all * ns > o.max_cells)
+    auto cells_of = [&](std::size_t s) { return grids[s].dimension() == 2 ? n * n : n * n * n; };
+    std::uint64_t all = 0;
+    for (std::size_t s = 0; s < ns; ++s) all += cells_of(s);
+    if (all > o.max_cells)
         throw std::runtime_error(
             fmt::format("attractor cover: the first grid (level {}) has {} cells, over the "
                         "budget of {} (max_cells)",
-                        o.initial_level, all * ns, o.max_cells));
+                        o.initial_level, all, o.max_cells));
     std::vector<std::vector<Key>> kept(ns);
-    for (auto& k : kept) {
-        k.resize(all);
-        for (Key i = 0; i < all; ++i) k[i] = i;
+    for (std::size_t s = 0; s < ns; ++s) {
+        kept[s].resize(cells_of(s));
+        for (Key i = 0; i < kept[s].size(); ++i) kept[s][i] = i;
     }
 
     for (int level = o.initial_level; level <= last; ++level) {
@@ -162,7 +196,8 @@ AttractorCoverResult build(int d, const std::vector<Grid>& grids, std::size_t in
                 }
                 cells.push_back({s_at, i_at});
                 states.push_back(s_at);
-                for (int a = 0; a < d; ++a) boxes.push_back(cell_box(s_at, kept[s_at][i_at], a));
+                for (int a = 0; a < grids[s_at].dimension(); ++a)
+                    boxes.push_back(cell_box(s_at, kept[s_at][i_at], a));
                 ++i_at;
             }
             if (cells.empty()) break;
@@ -175,7 +210,8 @@ AttractorCoverResult build(int d, const std::vector<Grid>& grids, std::size_t in
                     // Candidate index range per axis (one cell of margin; the exact test follows).
                     std::array<std::uint64_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
                     bool empty = false;
-                    for (int a = 0; a < d; ++a) {
+                    const int da = g.dimension();
+                    for (int a = 0; a < da; ++a) {
                         Interval& b = img.box[static_cast<std::size_t>(a)];
                         const Interval r = g.root[static_cast<std::size_t>(a)];
                         // A NaN bound says nothing: the image may reach anywhere along this axis.
@@ -200,7 +236,7 @@ AttractorCoverResult build(int d, const std::vector<Grid>& grids, std::size_t in
                             for (auto it = std::lower_bound(tk.begin(), tk.end(), from);
                                  it != tk.end() && *it <= to; ++it) {
                                 bool meets = true;
-                                for (int a = 0; a < d && meets; ++a) {
+                                for (int a = 0; a < da && meets; ++a) {
                                     const Interval cb = cell_box(img.state, *it, a);
                                     const Interval b = img.box[static_cast<std::size_t>(a)];
                                     meets = cb.lo <= b.hi && b.lo <= cb.hi;
@@ -220,7 +256,11 @@ AttractorCoverResult build(int d, const std::vector<Grid>& grids, std::size_t in
             }
         }
         step.arcs = targets.size();
-        const std::vector<bool> rec = recurrent_vertices(offsets, targets);
+        std::vector<bool> on_cycle_vertex(total);
+        for (std::size_t s = 0; s < ns; ++s)
+            std::fill(on_cycle_vertex.begin() + static_cast<std::ptrdiff_t>(base[s]),
+                      on_cycle_vertex.begin() + static_cast<std::ptrdiff_t>(base[s + 1]), grids[s].on_cycle);
+        const std::vector<bool> rec = kept_vertices(offsets, targets, on_cycle_vertex);
 
         // Record the initial state's cells of this level, then split the kept cells of every state.
         const std::uint64_t per_axis = n;
@@ -254,9 +294,10 @@ AttractorCoverResult build(int d, const std::vector<Grid>& grids, std::size_t in
                     continue;
                 }
                 const auto p = position(kept[s][i], n);
-                for (std::uint64_t c = 0; c < (d == 2 ? 4u : 8u); ++c)
+                const bool flat = grids[s].dimension() == 2;
+                for (std::uint64_t c = 0; c < (flat ? 4u : 8u); ++c)
                     next.push_back(key_of(2 * p[0] + (c & 1), 2 * p[1] + ((c >> 1) & 1),
-                                          d == 2 ? 0 : 2 * p[2] + ((c >> 2) & 1), 2 * n));
+                                          flat ? 0 : 2 * p[2] + ((c >> 2) & 1), 2 * n));
             }
             std::sort(next.begin(), next.end());
             kept[s] = std::move(next);
@@ -363,33 +404,74 @@ AttractorCoverResult map_attractor_cover(const std::vector<ir::Evaluator*>& comp
         for (std::size_t i = 0; i <= count; ++i) first[i] = i;
         for (Image& img : out) img.state = 0;
     };
-    return build(d, {make_grid(root)}, 0, images, options);
+    return build({make_grid(root)}, 0, images, options);
 }
 
-AttractorCoverResult automaton_attractor_cover(const ir::Automaton& a, const std::vector<Interval>& root,
+namespace {
+
+// The automaton whose initial state is euclidean: a barycentric initial state gets a state of the
+// output space in front of it, with the projection as its one arc (A_out = P(A_initial)).
+ir::Automaton with_euclidean_initial(const ir::Automaton& a) {
+    ir::Automaton out = a;
+    if (a.states[a.initial].space.kind != ir::Space::Kind::barycentric) return out;
+    if (!a.projection)
+        throw std::invalid_argument(fmt::format(
+            "attractor cover of automaton '{}': its barycentric initial state has no projection", a.name));
+    const std::size_t front = out.states.size();
+    out.states.push_back({"projection", ir::Space::euclidean(a.output_dimension()), {}});
+    out.arcs.push_back({front, a.initial, *a.projection, std::nullopt, "projection"});
+    out.initial = front;
+    out.projection.reset();
+    return out;
+}
+
+// The affine coordinates of a state's points: x for R^d, the first n - 1 weights for bary(n) (the last
+// is 1 minus their sum), so that every state's grid has as many axes as its space has dimensions.
+// The operator T of an arc a -> b in these coordinates is an affine map, rows(a) x (cols(b) + 1) with
+// the translation last: T composed with the embedding of b's coordinates, its redundant rows dropped
+// (T maps the hyperplane of b into that of a).
+num::Matrix<Interval> chart_operator(const num::Matrix<Interval>& t, ir::Space from, ir::Space to) {
+    const auto rows = static_cast<std::size_t>(from.dimension), cols = static_cast<std::size_t>(to.dimension);
+    const std::size_t last = static_cast<std::size_t>(to.coordinates()) - 1;
+    const bool bary = to.kind == ir::Space::Kind::barycentric;
+    num::Matrix<Interval> m(rows, cols + 1);
+    for (std::size_t r = 0; r < rows; ++r) {
+        // bary(n): the weights (u, 1 - sum u) give T[:, j] - T[:, n-1] per coordinate and T[:, n-1].
+        for (std::size_t c = 0; c < cols; ++c) m(r, c) = bary ? num::sub(t(r, c), t(r, last)) : t(r, c);
+        m(r, cols) = t(r, last);
+    }
+    return m;
+}
+
+} // namespace
+
+AttractorCoverResult automaton_attractor_cover(const ir::Automaton& input, const std::vector<Interval>& root,
                                                const AttractorCoverOptions& options) {
-    if (a.states.empty() || a.initial >= a.states.size())
+    if (input.states.empty() || input.initial >= input.states.size())
         throw std::invalid_argument("attractor cover: automaton without states");
-    const int d = a.states[a.initial].space.dimension;
+    const ir::Automaton a = with_euclidean_initial(input);
     for (const ir::State& s : a.states)
-        if (s.space.kind != ir::Space::Kind::euclidean || s.space.dimension != d || (d != 2 && d != 3))
+        if (s.space.dimension != 2 && s.space.dimension != 3)
             throw std::invalid_argument(
-                fmt::format("attractor cover of automaton '{}': every state must be R2, or "
-                            "every state R3 (state '{}' is {}); barycentric systems are "
-                            "drawn with the tree or the chaos game",
-                            a.name, s.name, ir::space_name(s.space)));
+                fmt::format("attractor cover of automaton '{}': state '{}' is {}; covers need spaces of "
+                            "dimension 2 or 3 (R2, R3, bary(3), bary(4))",
+                            input.name, s.name, ir::space_name(s.space)));
+    const int d = a.states[a.initial].space.dimension;
     // Boxes around the proven bounding balls for the states (also checks the operators and that the
-    // system contracts); the initial state's box is the caller's when given.
+    // system contracts); the initial state's box is the caller's when given. A ball of radius r in a
+    // state's norm (the euclidean norm of its homogeneous coordinates) bounds each affine coordinate
+    // within r of the centre's.
     const std::vector<StateBall> balls = bounding_balls(a);
     if (balls[a.initial].radius < 0)
-        throw std::invalid_argument(fmt::format("attractor cover: the attractor of '{}' is empty", a.name));
+        throw std::invalid_argument(
+            fmt::format("attractor cover: the attractor of '{}' is empty", input.name));
     std::vector<Grid> grids(a.states.size());
     {
         num::UpwardRounding up;
         for (std::size_t s = 0; s < a.states.size(); ++s) {
             std::vector<Interval> box;
             const double r = std::max(balls[s].radius, 0.0);
-            for (int i = 0; i < d; ++i) {
+            for (int i = 0; i < a.states[s].space.dimension; ++i) {
                 const double c = balls[s].radius < 0 ? 0.0 : balls[s].centre[static_cast<std::size_t>(i)];
                 box.push_back({num::sub(Interval(c), Interval(r)).lo, num::add(Interval(c), Interval(r)).hi});
                 if (!(box.back().lo < box.back().hi)) box.back() = {c - 1, c + 1}; // a point attractor
@@ -401,35 +483,50 @@ AttractorCoverResult automaton_attractor_cover(const ir::Automaton& a, const std
     // Arcs in the direction of the points: x in A_b gives T x in A_a for an arc a -> b; states whose
     // attractor is empty get no cells' images (their vertices stay transient).
     std::vector<std::vector<std::size_t>> into(a.states.size()); // arcs a -> b, by b
-    for (std::size_t i = 0; i < a.arcs.size(); ++i)
-        if (balls[a.arcs[i].from].radius >= 0 && balls[a.arcs[i].to].radius >= 0)
-            into[a.arcs[i].to].push_back(i);
+    std::vector<num::Matrix<Interval>> charts(a.arcs.size());
+    for (std::size_t i = 0; i < a.arcs.size(); ++i) {
+        const ir::Arc& arc = a.arcs[i];
+        if (balls[arc.from].radius < 0 || balls[arc.to].radius < 0) continue;
+        into[arc.to].push_back(i);
+        num::UpwardRounding up;
+        charts[i] = chart_operator(arc.op.enclosure, a.states[arc.from].space, a.states[arc.to].space);
+    }
+    // The states on a cycle of the graph (of arcs between states with attractors).
+    {
+        std::vector<std::uint64_t> offsets{0};
+        std::vector<std::uint32_t> targets;
+        for (std::size_t s = 0; s < a.states.size(); ++s) {
+            for (std::size_t i : into[s]) targets.push_back(static_cast<std::uint32_t>(a.arcs[i].from));
+            offsets.push_back(targets.size());
+        }
+        const std::vector<bool> cyclic = recurrent_vertices(offsets, targets);
+        for (std::size_t s = 0; s < a.states.size(); ++s) grids[s].on_cycle = cyclic[s];
+    }
     const ImageFn images = [&](const std::vector<std::size_t>& states, const std::vector<Interval>& boxes,
                                std::vector<Image>& out, std::vector<std::size_t>& first) {
         num::UpwardRounding up;
         first.assign(1, 0);
+        std::size_t at = 0; // the cell's first interval in `boxes`
         for (std::size_t c = 0; c < states.size(); ++c) {
+            const auto dim = static_cast<std::size_t>(a.states[states[c]].space.dimension);
             for (std::size_t i : into[states[c]]) {
-                const num::Matrix<Interval>& m = a.arcs[i].op.enclosure;
+                const num::Matrix<Interval>& m = charts[i];
                 Image img;
                 img.state = a.arcs[i].from;
-                for (int r = 0; r < d; ++r) {
-                    Interval v = m(static_cast<std::size_t>(r), static_cast<std::size_t>(d));
-                    for (int k = 0; k < d; ++k)
-                        v = num::add(
-                            v,
-                            num::mul(m(static_cast<std::size_t>(r), static_cast<std::size_t>(k)),
-                                     boxes[c * static_cast<std::size_t>(d) + static_cast<std::size_t>(k)]));
-                    img.box[static_cast<std::size_t>(r)] = v;
+                for (std::size_t r = 0; r < m.rows(); ++r) {
+                    Interval v = m(r, dim);
+                    for (std::size_t k = 0; k < dim; ++k) v = num::add(v, num::mul(m(r, k), boxes[at + k]));
+                    img.box[r] = v;
                 }
                 out.push_back(img);
             }
+            at += dim;
             first.push_back(out.size());
         }
     };
     // Vertices of states the initial one does not reach have no images, so they are transient after
     // the first graph and cost nothing later.
-    return build(d, grids, a.initial, images, options);
+    return build(grids, a.initial, images, options);
 }
 
 } // namespace frac::rt

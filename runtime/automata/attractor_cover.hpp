@@ -11,10 +11,14 @@
 // Two inputs:
 //  - a map of the plane (or space) given by its components, each an ir::Evaluator of the d
 //    coordinates: the attractor of its non-divergent orbits (Hénon, Julia sets);
-//  - an automaton (IFS, graph-directed IFS) with euclidean states of one dimension: the vertices are
-//    (state, cell) pairs, each state with its own grid (the initial state over the given box, the
-//    others over boxes around their proven bounding balls), with an arc (b, C) -> (a, C') when the
-//    operator of an arc a -> b maps C onto a set meeting C'.
+//  - an automaton (IFS, graph-directed IFS, euclidean or barycentric states): the vertices are
+//    (state, cell) pairs, each state with its own grid in its affine coordinates (x for R2 and R3, the
+//    first n - 1 weights for bary(3) and bary(4)), the initial state over the given box, the others
+//    over boxes around their proven bounding balls, with an arc (b, C) -> (a, C') when the operator of
+//    an arc a -> b maps C onto a set meeting C'. A barycentric initial state gets a state of the output
+//    space in front, reached through the projection. Cells of states on a cycle of the automaton are
+//    kept when they are recurrent; cells of a state on no cycle (a projected spline's) when a kept
+//    cell maps onto them: A_a is the union of the images of its successors' attractors.
 // The result is an rt::Cover of the (initial state's) attractor: at each refined level the cells that
 // were kept are `subdivided` and the transient ones `outside`, at the last level the kept cells are
 // `boundary`; the levels above the first graph hold the ancestors of its kept cells. So pictures,
@@ -66,9 +70,9 @@ AttractorCoverResult map_attractor_cover(const std::vector<ir::Evaluator*>& comp
                                          const std::vector<Interval>& root,
                                          const AttractorCoverOptions& options = {});
 
-// The attractor of an automaton's initial state inside `root` (empty: the box around its proven
-// bounding ball). Its states must be euclidean of dimension 2 or 3 (std::invalid_argument otherwise:
-// barycentric systems are drawn with the tree or the chaos game).
+// The attractor of an automaton's initial state (through its projection when it is barycentric)
+// inside `root` (empty: the box around its proven bounding ball). Every state's space must have
+// dimension 2 or 3 (std::invalid_argument otherwise).
 AttractorCoverResult automaton_attractor_cover(const ir::Automaton& a, const std::vector<Interval>& root,
                                                const AttractorCoverOptions& options = {});
 

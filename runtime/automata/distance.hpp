@@ -69,7 +69,9 @@ struct BruteForceResult {
     std::uint64_t leaves = 0;
 };
 
-// Immutable after construction: every query is const and may run on any thread.
+// Immutable after construction: every query is const and may run on any thread. Construction is in
+// distance.cpp; the queries and serialization (distance_query.cpp) need only the numeric core, so
+// compiled models link them alone (libfrac_aot_automata.a).
 class AttractorDistance {
 public:
     // Throws std::invalid_argument as bounding_balls does, when the initial state's attractor is
@@ -101,7 +103,15 @@ public:
     // rho the largest arc Lipschitz bound); -1 when rho >= 1.
     int brute_force_level(double epsilon) const;
 
+    // What the queries read, as bytes in this host's byte order (compiled models carry it: frac
+    // compile), and back. deserialize throws std::invalid_argument when `data` is not what serialize
+    // wrote.
+    std::vector<std::uint8_t> serialize() const;
+    static AttractorDistance deserialize(const std::uint8_t* data, std::size_t size);
+
 private:
+    AttractorDistance() = default;
+
     struct ArcData {
         std::size_t to = 0;
         std::vector<Interval> op; // rows(from) x cols(to), row-major

@@ -450,3 +450,41 @@ TEST_CASE("compiled functions are reentrant: threads in different rounding modes
         CHECK(modes_after[static_cast<std::size_t>(t)] == modes[t]);
     }
 }
+
+TEST_CASE("a compiled model that calls dist carries its automaton and gives the JIT's enclosures") {
+    const fs::path dir = work_dir("dist");
+    const fs::path model = dir / "dist.frac";
+    // A euclidean IFS, one composed with a Rvachev shape by CSG, and a barycentric CIFS drawn through
+    // its control points.
+    std::ofstream(model)
+        << "import \"ifs\";\nimport \"fractals\";\n"
+           "shape ring(x, y) over [-0.25, 1.25] × [-0.25, 1.25] = dist((x, y), sierpinski) - "
+           "0.01;\n"
+           "shape fused(x, y) over [0, 1] × [0, 1] = dist((x, y), sierpinski) - 0.01 | carpet(x, "
+           "y);\n"
+           "shape curve(x, y) over [-1, 4] × [-1, 3] = dist((x, y), quadratic_bspline) - 0.05;\n";
+    CHECK(compare_library(dir, model.string(), "", {}, 23, 100) >= 3); // and the imported shapes
+
+    // The same object twice in one process: each library rebuilds its own automaton, and unloading one
+    // leaves the other working.
+    const fs::path so = dir / "model.so";
+    Library first(so);
+    const CShape f = lookup(first.handle, "frac_", "ring");
+    // (0.5, 0.5) lies (0.5 - sqrt(3)/4) / 2 from the Sierpinski triangle
+    // (tests/lang/automata/dist_test.frac).
+    const double centre[2] = {0.5, 0.5};
+    const double truth = (0.5 - std::sqrt(3.0) / 4) / 2 - 0.01;
+    const Interval thin[2] = {Interval(0.5), Interval(0.5)};
+    const Interval r = f.box(thin);
+    CHECK(r.lo <= truth);
+    CHECK(truth <= r.hi);
+    CHECK(r.hi - r.lo < 2e-6);
+    CHECK(std::fabs(f.point(centre) - truth) < 1e-6);
+    {
+        const fs::path copy = dir / "copy.so";
+        fs::copy_file(so, copy);
+        Library second(copy);
+        CHECK(same(lookup(second.handle, "frac_", "ring").box(thin), r));
+    }
+    CHECK(same(f.box(thin), r));
+}

@@ -305,3 +305,17 @@ TEST_CASE("closed expressions (no coordinates) agree on every engine", "[conform
     CHECK(a->dimension() == 0);
     CHECK(engines_differ(t, {}, 1, 4) == "");
 }
+
+TEST_CASE("dist(p, A) agrees on every engine, compiled models included", "[conformance][dist]") {
+    // A euclidean IFS composed by CSG, and a projected B-spline CIFS (a bary(3) state).
+    const Model m = compile("import \"ifs\";\nimport \"fractals\";\n"
+                            "shape fused(x, y) = dist((x, y), sierpinski) - 0.01 | carpet(x, y);\n"
+                            "shape curve(x, y) = dist((x, y), quadratic_bspline) - 0.05;\n");
+    std::uint64_t seed = 40;
+    for (std::size_t i = 0; i < m.tapes.size(); ++i) {
+        if (m.shape(i).name != "fused" && m.shape(i).name != "curve") continue;
+        INFO(m.shape(i).name);
+        REQUIRE(!m.tapes[i].externals.empty());
+        CHECK(engines_differ(m.tapes[i], {{-0.5, 3.5}, {-0.5, 2.5}}, ++seed, 60) == "");
+    }
+}

@@ -100,7 +100,8 @@ bcifs edge {
 }
 
 TEST_CASE("bcifs errors are located and specific", "[bcifs]") {
-    const std::string cells = "cell v in bary(1); cell e in bary(3); project = controls((0, 0), (1, 1), (2, 0)); ";
+    const std::string cells =
+        "cell v in bary(1); cell e in bary(3); project = controls((0, 0), (1, 1), (2, 0)); ";
     CHECK_THAT(test::errors_of("bcifs b { " + cells + "topology e = edge(v) split 2; fix e.T0[0][0] = 2; }"),
                Catch::Contains("conflict") && Catch::Contains("note: fix e.T0[0][0]"));
     CHECK_THAT(test::errors_of("bcifs b { " + cells + "topology e = quad(v) split 2 x 2; }"),
@@ -117,4 +118,27 @@ TEST_CASE("bcifs errors are located and specific", "[bcifs]") {
                                "subdivide e { T0 = [[1, sqrt(2), 0], [0, 0, 0], [0, 1, 1]]; } }"),
                Catch::Contains("exact numbers"));
     CHECK_THAT(test::errors_of("const m = 2 * ?;"), Catch::Contains("'?'"));
+}
+
+TEST_CASE("a volume cell: a cube split 2 x 2 x 2 over quad faces, solved and proven contractive", "[bcifs]") {
+    auto c = test::compile_ok(R"(
+bcifs block {
+  cell v in bary(1);
+  cell e in bary(3);
+  cell f in bary(9);
+  cell c in bary(27);
+  topology e = edge(v) split 2;
+  topology f = quad(e) split 2 x 2;
+  topology c = cube(f) split 2 x 2 x 2;
+  project = controls((0,0,0), (1,0,0), (2,0,0), (0,1,0), (1,1,0), (2,1,0), (0,2,0), (1,2,0), (2,2,0),
+                     (0,0,1), (1,0,1), (2,0,1), (0,1,1), (1,1,1.5), (2,1,1), (0,2,1), (1,2,1), (2,2,1),
+                     (0,0,2), (1,0,2), (2,0,2), (0,1,2), (1,1,2), (2,1,2), (0,2,2), (1,2,2), (2,2,2));
+}
+)");
+    // edge 3, face 12, cube: 6 faces x 4 sub-patches + 3 axes x 4 neighbour pairs.
+    CHECK(check_constraints(*c) == 3 + 12 + 24 + 12);
+    const front::AutomatonInfo& info = *c->module.find_automaton("block");
+    CHECK(info.dof == std::vector<int>{0, 6, 72, 702});
+    CHECK(info.automaton.arcs.size() == 1 + 2 + 4 + 8);
+    CHECK(info.automaton.embeddings.size() == 2 + 4 + 6);
 }

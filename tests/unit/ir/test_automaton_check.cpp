@@ -55,19 +55,49 @@ TEST_CASE("the contraction bound of similitudes is their ratio", "[automaton_che
     CHECK(p.per_step < 1.0);
 }
 
-TEST_CASE("B-spline subdivision matrices need products along paths", "[automaton_check]") {
+TEST_CASE("B-spline subdivision matrices contract in the 1-norm of their full coordinates",
+          "[automaton_check]") {
     const ir::Automaton cubic = bspline(3, {{0, 0}, {1, 2}, {3, 2}, {4, 0}});
-    // Their single-step norms in the direction coordinates exceed 1.
+    // Their single-step 2-norms in the direction coordinates exceed 1 ...
     double worst = 0;
     for (std::size_t i = 0; i < cubic.arcs.size(); ++i)
         if (cubic.arcs[i].from == 1) worst = std::max(worst, ir::norm2_upper(ir::linear_part(cubic, i)));
     CHECK(worst > 1.0);
+    // ... but on zero-sum weights with the 1-norm each split matrix contracts by its ergodicity coefficient:
+    // 1/2 max over column pairs of the 1-norm of their difference, computed here exactly.
+    num::Rational coefficient(0);
+    for (const ir::Arc& arc : cubic.arcs) {
+        if (arc.from != 1 || arc.to != 1) continue;
+        const auto& m = *arc.op.exact;
+        for (std::size_t j = 0; j < m.cols(); ++j)
+            for (std::size_t k = j + 1; k < m.cols(); ++k) {
+                num::Rational sum(0);
+                for (std::size_t r = 0; r < m.rows(); ++r) {
+                    const num::Rational d = m(r, j) - m(r, k);
+                    sum += d.sign() < 0 ? -d : d;
+                }
+                coefficient = std::max(coefficient, sum / num::Rational(2));
+            }
+    }
     const auto proof = ir::prove_contractive(cubic);
     REQUIRE(proof.proven);
-    CHECK(proof.length > 1);
-    CHECK(mentions(proof.method, "paths of length"));
+    CHECK(proof.length == 1);
+    CHECK(proof.bound == Approx(coefficient.to_double()).epsilon(1e-12));
+    CHECK(proof.bound >= coefficient.to_double()); // rounded up, never below the true coefficient
     // The contraction per step is at least the subdominant eigenvalue 1/2 of the subdivision.
     CHECK(proof.per_step >= 0.5);
+}
+
+TEST_CASE("the 1-norm bound never proves an expanding barycentric map", "[automaton_check]") {
+    // Columns summing to 1 with a subdominant eigenvalue 1.25 on the hyperplane: no norm can prove it.
+    ir::Automaton a;
+    a.name = "grow";
+    a.states.push_back({"b", ir::Space::barycentric(2), {}});
+    ir::Arc arc;
+    arc.op = ir::Operator::from_exact(num::Matrix<num::Rational>{
+        {num::Rational(9, 8), num::Rational(-1, 8)}, {num::Rational(-1, 8), num::Rational(9, 8)}});
+    a.arcs.push_back(arc);
+    CHECK_FALSE(ir::prove_contractive(a).proven);
 }
 
 TEST_CASE("a non-contractive cycle is named in the refusal", "[automaton_check]") {

@@ -1,7 +1,7 @@
 // The builtin dist(p, A): the distance to the attractor of an automaton, an external function of the IR
 // bound by the driver to the runtime's branch and bound. Both engines call the same implementation, so
 // they agree bit for bit; box results enclose the distance; RSS covers of dist(p, A) - r hold every
-// chaos-game point; compiled (AOT) models refuse it.
+// chaos-game point; compiled (AOT) models embed the automaton (tests/aot compares them with the JIT).
 #include "engines.hpp"
 
 #include "backend/llvm/aot.hpp"
@@ -10,7 +10,10 @@
 #include "runtime/rss.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <tuple>
 
@@ -179,13 +182,60 @@ TEST_CASE("dist: an RSS cover of dist(p, A) - r holds every chaos-game point", "
     }
 }
 
-TEST_CASE("dist: compiled models refuse it (the runtime is not linked into them)", "[llvm][dist]") {
+TEST_CASE("dist: compiled models embed the automaton and resolve it at the first call", "[llvm][dist]") {
     const Model m = compile(model);
     const std::size_t ring = shape_index(m, "ring");
+    const auto& f = bound_distance(m);
+    const std::optional<ir::ExternalFunction::Compiled> c = f.compiled();
+    REQUIRE(c);
+    CHECK(c->archive == "libfrac_aot_automata.a");
     jit::AotShape s{"ring", m.tapes[ring], m.shape(ring).box};
-    jit::AotConfig config;
-    const std::string object = "/tmp/frac_test_dist_refused.o";
-    REQUIRE_THROWS_WITH(
-        jit::compile_aot({s}, config, object, ""),
-        Catch::Contains("dist(...), which needs the runtime: not available in compiled models"));
+    CHECK(jit::external_archives({s}) == std::vector<std::string>{"libfrac_aot_automata.a"});
+    const std::string ll = "/tmp/frac_test_dist_embedded.ll";
+    jit::compile_aot({s}, jit::AotConfig{}, "", ll);
+    std::ifstream in(ll);
+    const std::string ir_text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    CHECK(ir_text.find("@frac_aot_attractor_distance(ptr") != std::string::npos);
+    CHECK(ir_text.find("@frac_aot_attractor_distance_release(ptr") != std::string::npos);
+    CHECK(ir_text.find("@llvm.global_dtors") != std::string::npos);
+    std::remove(ll.c_str());
+
+    // The C entry points on the embedded data: the same function, built once, then freed.
+    ir::ExternalData record{nullptr, c->data.size(), c->data.data()};
+    const ir::ExternalFunction* rebuilt = frac_aot_attractor_distance(&record);
+    REQUIRE(rebuilt);
+    CHECK(frac_aot_attractor_distance(&record) == rebuilt);
+    CHECK(rebuilt->name() == "dist sierpinski");
+    const Interval box[2] = {{0.3, 0.4}, {0.6, 0.65}};
+    CHECK(same_bits(rebuilt->eval_box(box), f.eval_box(box)));
+    const double p[2] = {0.5, 0.5};
+    CHECK(same_bits(rebuilt->eval_point(p), f.eval_point(p)));
+    frac_aot_attractor_distance_release(&record);
+    CHECK(record.function == nullptr);
+
+    // Malformed data (truncated, or a byte changed in the format tag) rebuilds nothing.
+    for (std::size_t size : {std::size_t(0), std::size_t(7), c->data.size() - 1}) {
+        ir::ExternalData cut{nullptr, size, c->data.data()};
+        CHECK(frac_aot_attractor_distance(&cut) == nullptr);
+    }
+    std::vector<std::uint8_t> bad = c->data;
+    bad[8 + std::string("sierpinski").size()] ^= 1;
+    ir::ExternalData wrong{nullptr, bad.size(), bad.data()};
+    CHECK(frac_aot_attractor_distance(&wrong) == nullptr);
+}
+
+TEST_CASE("dist: an external function without a compiled form is refused by frac compile", "[llvm][dist]") {
+    class Opaque final : public ir::ExternalFunction {
+    public:
+        int arity() const override { return 2; }
+        num::Interval eval_box(const num::Interval*) const override { return {0, 1}; }
+        double eval_point(const double*) const override { return 0.5; }
+        std::string name() const override { return "opaque"; }
+    };
+    Model m = compile(model);
+    const std::size_t ring = shape_index(m, "ring");
+    jit::AotShape s{"ring", m.tapes[ring], m.shape(ring).box};
+    s.tape.externals[0] = std::make_shared<Opaque>();
+    REQUIRE_THROWS_WITH(jit::compile_aot({s}, jit::AotConfig{}, "", ""),
+                        Catch::Contains("shape 'ring' calls opaque, which compiled models cannot carry"));
 }
