@@ -80,6 +80,10 @@ int mesh_automaton(const front::AutomatonInfo& a, const MeshOptions& options);
 // The similarity dimension with its proven bracket, or box counting of the chaos-game cover.
 int automaton_dimension(const front::AutomatonInfo& a, int from, int to);
 
+// frac analyze FILE NAME: the verified spectrum of every subdivision operator (an arc from a barycentric
+// state to itself), the behaviour at its fixed point, and the junctions between pieces.
+int run_analyze(const std::string& file, const std::string& name);
+
 // frac render for an ifs or cifs (--method tree, chaos or cover).
 int render_automaton(const front::AutomatonInfo& a, const RenderOptions& options);
 // frac render for a map of the plane (fn henon(p) = ...): the cell-graph cover of its attractor in --box.

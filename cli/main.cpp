@@ -226,6 +226,14 @@ int run(int argc, char** argv) {
         ->capture_default_str();
     chaos->add_option("--size", chaos_options.size, "picture width in pixels")->capture_default_str();
 
+    std::string analyze_name;
+    auto* analyze = app.add_subcommand(
+        "analyze", "verified eigenvalues of the subdivision operators of a cifs: tangents, spirals, "
+                   "oscillations at its vertices and junctions");
+    analyze->add_option("file", file, "model file")->required();
+    analyze->add_option("name", analyze_name, "ifs or cifs name")->required();
+    add_set(analyze);
+
     std::vector<std::string> files;
     auto* test = app.add_subcommand("test", "run the test blocks of model files");
     test->add_option("files", files, "model files")->required();
@@ -314,6 +322,7 @@ int run(int argc, char** argv) {
             return cli::run_tree(file, tree_options);
         }
         if (*chaos) return cli::run_chaos(file, chaos_options);
+        if (*analyze) return cli::run_analyze(file, analyze_name);
         if (*solve) return cli::run_solve(file, solve_name);
         if (*mesh) return cli::run_mesh(file, mesh_options, engine);
         if (*test) return cli::run_tests(files, false, engine);

@@ -47,6 +47,11 @@ automaton cubic_bspline tree 6 svg
 automaton barnsley_fern chaos "" png
 automaton fern_of_triangles chaos "" png
 automaton penrose chaos "" png
+# Seed 004's junctions of a cubic and a quadratic B-spline (examples/differential.frac, frac analyze):
+# G1 (λ2 > 0), a spiral (complex λ2) and an oscillation (λ2 < 0) at the junction point.
+for j in junction_g1 junction_spiral junction_oscillation; do
+    "$frac" render "$here/differential.frac" "$j" --method tree --depth 10 -o "$out/$j.svg"
+done
 # Boundary controlled IFS (examples/bcifs.frac): constraints solved by the compiler, drawn by the chaos game.
 for name in fractal_edge spiky_edge c1_edge quad_patch; do
     "$frac" render "$here/bcifs.frac" "$name" --method chaos --size 512 -o "$out/bcifs_$name.png"
