@@ -17,7 +17,19 @@
 
 namespace frac::driver {
 
-enum class Stage { lex, parse, constraints, resolve, typecheck, const_eval, lower, automaton, tape, specialize, codegen };
+enum class Stage {
+    lex,
+    parse,
+    constraints,
+    resolve,
+    typecheck,
+    const_eval,
+    lower,
+    automaton,
+    tape,
+    specialize,
+    codegen
+};
 
 struct StageInfo {
     Stage stage;
