@@ -21,6 +21,12 @@ AffineForm substitute(const AffineForm& f, const std::vector<AffineForm>& values
     return out;
 }
 
+// An operator's entries with every variable replaced by its current value.
+Forms substitute_all(Forms f, const std::vector<AffineForm>& values) {
+    for (AffineForm& e : f) e = substitute(e, values);
+    return f;
+}
+
 struct Product {
     Forms entries;
     std::size_t rows = 0, cols = 0;
@@ -97,11 +103,7 @@ std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& sys, Diagnostics& di
     std::size_t equations = 0;
     for (;;) {
         num::LinearSystem system(variables);
-        const auto current = [&](std::size_t j) {
-            Forms f = forms[j];
-            for (AffineForm& e : f) e = substitute(e, values);
-            return f;
-        };
+        const auto current = [&](std::size_t j) { return substitute_all(forms[j], values); };
         for (std::size_t j = 0; j < sys.operators.size(); ++j) {
             const auto& op = sys.operators[j];
             if (!op.barycentric) continue;
@@ -200,11 +202,7 @@ std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& sys, Diagnostics& di
             for (const auto* side : {&c.left, &c.right})
                 for (const auto& f : *side)
                     if (f.op) {
-                        const Forms cur = [&] {
-                            Forms m = forms[*f.op];
-                            for (AffineForm& e : m) e = substitute(e, values);
-                            return m;
-                        }();
+                        const Forms cur = substitute_all(forms[*f.op], values);
                         const std::string name =
                             fmt::format("{}.{}", sys.operators[*f.op].cell, sys.operators[*f.op].name);
                         if (std::find(unknown.begin(), unknown.end(), name) == unknown.end() &&
@@ -227,11 +225,7 @@ std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& sys, Diagnostics& di
     out.unknowns = variables - sys.params.size();
     out.equations = equations;
     out.rank = solution.rank;
-    for (std::size_t j = 0; j < sys.operators.size(); ++j) {
-        Forms f = forms[j];
-        for (AffineForm& e : f) e = substitute(e, values);
-        out.entries.push_back(std::move(f));
-    }
+    for (const Forms& f : forms) out.entries.push_back(substitute_all(f, values));
     // Names: the parameters' own, then one letter per (operator, column) of the free entries.
     out.variable_names.assign(variables, "");
     for (std::size_t p = 0; p < sys.params.size(); ++p) out.variable_names[p] = sys.params[p];
