@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <pthread.h>
 
 namespace {
@@ -56,10 +57,19 @@ int run(int argc, char** argv) {
     cli::EngineOptions engine;
     // Constant overrides, NAME=VALUE, applied to the model before it is compiled.
     std::vector<std::string> sets;
-    auto add_set = [&](CLI::App* sub) {
+    // The seed of the values of free bcifs entries: --free-seed everywhere, --seed where the command has
+    // no other seed (chaos seeds its points with --seed).
+    std::optional<std::uint64_t> free_entry_seed;
+    auto add_set = [&](CLI::App* sub, bool seed_alias = true) {
         sub->add_option("--set", sets, "override a constant of the model: NAME=VALUE (repeatable)")
             ->type_name("NAME=VALUE")
             ->allow_extra_args(false);
+        sub->add_option_function<std::uint64_t>(
+               seed_alias ? "--seed,--free-seed" : "--free-seed",
+               [&](const std::uint64_t& seed) { free_entry_seed = seed; },
+               "give the free entries of every bcifs values drawn from this seed (reproducible) instead "
+               "of the most uniform ones")
+            ->type_name("N");
     };
     auto add_engine = [&](CLI::App* sub) {
         sub->add_option("--engine", engine.engine,
@@ -197,6 +207,7 @@ int run(int argc, char** argv) {
     tree->add_option("file", file, "model file")->required();
     tree->add_option("name", tree_options.name, "ifs or cifs name")->required();
     tree->add_option("--depth", tree_options.depth, "levels of the tree (0 to 24)")->capture_default_str();
+    add_set(tree);
     tree->add_option("-o,--output", tree_options.output,
                      "picture file: .png or .svg (curves as polylines); without it the tree is printed");
     tree->add_option("--size", tree_options.size, "picture width and height in pixels")
@@ -212,6 +223,7 @@ int run(int argc, char** argv) {
         "solve", "solve the constraints of a bcifs: its operators with exact entries and free parameters");
     solve->add_option("file", file, "model file")->required();
     solve->add_option("name", solve_name, "bcifs name (default: every bcifs of the file)");
+    add_set(solve);
 
     cli::ChaosCommandOptions chaos_options;
     auto* chaos = app.add_subcommand("chaos", "the chaos game of an ifs or cifs, as a density picture");
@@ -225,6 +237,7 @@ int run(int argc, char** argv) {
         ->check(CLI::Range(1, 256))
         ->capture_default_str();
     chaos->add_option("--size", chaos_options.size, "picture width in pixels")->capture_default_str();
+    add_set(chaos, false);
 
     std::string analyze_name;
     auto* analyze = app.add_subcommand(
@@ -311,6 +324,7 @@ int run(int argc, char** argv) {
                                               front::list_names(names)));
         }
         cli::set_constant_overrides(sets);
+        cli::set_free_entry_seed(free_entry_seed);
         if (*check) return cli::run_check(file, emit, shape, time_passes);
         if (*eval) return cli::run_eval(file, shape, at, box, engine);
         if (*render) return cli::run_render(file, render_options, engine);

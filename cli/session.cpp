@@ -14,7 +14,12 @@ namespace frac::cli {
 
 namespace {
 front::ConstOverrides constant_overrides;
+std::optional<std::uint64_t> free_entry_seed;
 } // namespace
+
+void set_free_entry_seed(std::optional<std::uint64_t> seed) {
+    free_entry_seed = seed;
+}
 
 void set_constant_overrides(const std::vector<std::string>& sets) {
     constant_overrides.clear();
@@ -38,6 +43,7 @@ std::unique_ptr<front::Compilation> compile_or_report(const std::string& path, d
     if (const auto nodes = positive_env("FRAC_MAX_INLINE_NODES", "expression nodes"))
         options.limits.max_inline_nodes = static_cast<std::uint64_t>(std::min(*nodes, 1e18));
     options.overrides = constant_overrides;
+    options.free_entry_seed = free_entry_seed;
     options.times = times;
     auto c = driver::compile_file(path, options);
     if (!c->unknown_overrides.empty()) {

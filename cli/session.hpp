@@ -25,6 +25,8 @@ struct UsageError : std::runtime_error {
 // The --set NAME=VALUE options of the command; every later compile_or_report applies them. Throws
 // UsageError when one is not NAME=VALUE or its value is not a constant expression.
 void set_constant_overrides(const std::vector<std::string>& sets);
+// --seed N: every later compile_or_report gives the free entries of a bcifs values drawn from N.
+void set_free_entry_seed(std::optional<std::uint64_t> seed);
 
 // Compiles `path`; on errors prints the diagnostics to stderr and returns null.
 // `times`, when not null, gets the time of each stage run.

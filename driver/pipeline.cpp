@@ -101,7 +101,8 @@ void run_frontend(front::Compilation& c, const CompileOptions& options) {
     });
     if (options.stop < Stage::lower) return;
     timed(options.times, stage_name(Stage::lower), [&] {
-        front::lower(c.program, c.typed, c.sources, options.limits, c.module, c.diags, &c.constants);
+        front::lower(c.program, c.typed, c.sources, options.limits, c.module, c.diags, &c.constants,
+                     options.free_entry_seed);
     });
     // The runtime's implementations of the graph's external functions (dist): tapes carry them.
     if (!c.diags.has_errors()) timed(options.times, "bind", [&] { bind_externals(c.module, c.diags); });

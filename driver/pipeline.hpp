@@ -55,7 +55,8 @@ struct CompileOptions {
     front::Limits limits;
     Stage stop = Stage::lower; // the last frontend stage to run (lex and parse run together)
     front::ConstOverrides overrides;
-    PassTimes* times = nullptr; // filled when not null
+    std::optional<std::uint64_t> free_entry_seed; // --seed: drawn values for free bcifs entries
+    PassTimes* times = nullptr;                   // filled when not null
 };
 
 // Runs the frontend stages up to options.stop. Never throws for a bad model: problems are in `diags`.

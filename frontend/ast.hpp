@@ -4,7 +4,9 @@
 #include "frontend/diagnostics.hpp"
 #include "frontend/lexer.hpp"
 
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -82,6 +84,10 @@ struct StateDecl {
     Location loc;
     SpaceDecl space;
     ExprPtr primitive; // drawn at the leaves of evaluation trees, or null
+    // A bcifs cell taken from another bcifs (`cell l = spline.e;`): its space and its solved operators
+    // (frontend/cell_import.hpp); empty for a declared cell.
+    std::string source, source_cell;
+    Location source_loc;
 };
 
 struct ArcDecl {
@@ -101,6 +107,9 @@ struct OperatorDecl {
     Location loc, target_loc;
     ExprPtr value; // null: unknown; a matrix whose entries may be unknown (is_unknown); or an expression
     bool generated = false; // by a topology declaration
+    // An operator of a cell taken from another bcifs: the solved operator source.source_cell.name,
+    // known when this bcifs is lowered; empty otherwise.
+    std::string source, source_cell;
 };
 
 // One factor of a constraint's product: an operator `cell.name`, or a constant matrix.
@@ -139,6 +148,8 @@ struct TopologyDecl {
 };
 
 struct BcifsDecl {
+    // seed N;  the free entries take values drawn from N (as with --seed, which overrides it).
+    std::optional<std::uint64_t> seed;
     std::vector<TopologyDecl> topologies;
     std::vector<OperatorDecl> operators;
     std::vector<ConstraintDecl> constraints;

@@ -40,6 +40,7 @@ std::string print_factors(const std::vector<FactorDecl>& side) {
 
 std::string print_bcifs(const BcifsDecl& b) {
     std::string out;
+    if (b.seed) out += fmt::format("\n  (seed {})", *b.seed);
     for (const ParamDecl& p : b.params)
         out += fmt::format("\n  (param {}{}{})", p.name,
                            p.lo ? fmt::format(" (in {} {})", print_expr(*p.lo), print_expr(*p.hi)) : "",
@@ -136,8 +137,10 @@ std::string print_ast(const Program& p, std::uint32_t file) {
             const AutomatonDecl& a = *it.automaton;
             out += fmt::format("({} {}", a.bcifs ? "bcifs" : a.graph_directed ? "cifs" : "ifs", it.name);
             for (const StateDecl& s : a.states)
-                out += fmt::format("\n  (state {} {}{}{})", s.name, s.space.barycentric ? "bary" : "R",
-                                   s.space.n,
+                out += fmt::format("\n  (state {} {}{})", s.name,
+                                   s.source.empty()
+                                       ? fmt::format("{}{}", s.space.barycentric ? "bary" : "R", s.space.n)
+                                       : fmt::format("(from {}.{})", s.source, s.source_cell),
                                    s.primitive ? " (primitive " + print_expr(*s.primitive) + ")" : "");
             for (const ArcDecl& arc : a.arcs)
                 out += fmt::format("\n  (arc {} {}{} {}{})", arc.from, arc.to,

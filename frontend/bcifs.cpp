@@ -165,17 +165,31 @@ std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& sys, Diagnostics& di
                 system.add(sides[0].entries[e] - sides[1].entries[e], k);
         }
         equations = system.equations();
-        solution = system.solve();
-        if (!solution.consistent) {
+        solution = system.solve(sys.tolerance);
+        if (solution.ill_conditioned) {
             diags.error(
-                sys.constraints.empty()                   ? sys.operators.front().loc
-                : solution.conflict.front() < column_sums ? sys.constraints[solution.conflict.front()].loc
-                                                          : sys.operators.front().loc,
-                solution.conflict.size() == 1
-                    ? fmt::format("a constraint of bcifs '{}' cannot hold with these operators", sys.name)
-                    : fmt::format("the constraints of bcifs '{}' conflict: no operators satisfy these {} "
-                                  "together (without any one of them the rest have a solution)",
-                                  sys.name, solution.conflict.size()));
+                sys.inexact_at,
+                fmt::format("the constraints of bcifs '{}' are too close to a change of rank to solve "
+                            "in floating point: elimination finds rank {}, a QR factorisation {} at "
+                            "tolerance {:g} (this entry is not exact; exact entries are solved exactly)",
+                            sys.name, solution.rank, solution.qr_rank, *sys.tolerance));
+            return std::nullopt;
+        }
+        if (!solution.consistent) {
+            // Located at the first source: a constraint, a barycentric operator, or a fix.
+            const std::size_t first = solution.conflict.front();
+            diags.error(
+                first < column_sums ? sys.constraints[first].loc
+                : first < fixes     ? sys.operators[first - column_sums].loc
+                                    : sys.fixes[first - fixes].loc,
+                (solution.conflict.size() == 1
+                     ? fmt::format("a constraint of bcifs '{}' cannot hold with these operators", sys.name)
+                     : fmt::format("the constraints of bcifs '{}' conflict: no operators satisfy these {} "
+                                   "together (without any one of them the rest have a solution)",
+                                   sys.name, solution.conflict.size())) +
+                    (sys.tolerance
+                         ? fmt::format(" (solved in floating point, residuals above {:g})", *sys.tolerance)
+                         : std::string()));
             for (std::size_t s : solution.conflict) {
                 if (s < column_sums) {
                     diags.note(sys.constraints[s].loc, fmt::format("constraint {}", sys.constraints[s].text));
@@ -225,6 +239,7 @@ std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& sys, Diagnostics& di
     out.unknowns = variables - sys.params.size();
     out.equations = equations;
     out.rank = solution.rank;
+    out.tolerance = sys.tolerance;
     for (const Forms& f : forms) out.entries.push_back(substitute_all(f, values));
     // Names: the parameters' own, then one letter per (operator, column) of the free entries.
     out.variable_names.assign(variables, "");
@@ -298,13 +313,19 @@ std::vector<Rational> most_uniform_values(const BcifsSystem& sys, const BcifsSol
 }
 
 std::string BcifsSolution::print_entry(const AffineForm& f) const {
+    // Solved in floating point: the shortest decimals that read back as the doubles found.
+    const auto number = [&](const Rational& x) {
+        return tolerance ? fmt::format("{}", x.to_double()) : x.to_string();
+    };
     std::string s;
-    if (!f.constant.is_zero() || f.terms.empty()) s = f.constant.to_string();
+    if (!f.constant.is_zero() || f.terms.empty()) s = number(f.constant);
     for (const auto& [v, a] : f.terms) {
         const std::string& name = variable_names[v];
         const Rational m = a.sign() < 0 ? -a : a;
         std::string term;
-        if (m.is_integer())
+        if (tolerance)
+            term = m == Rational(1) ? name : fmt::format("{}*{}", number(m), name);
+        else if (m.is_integer())
             term = m == Rational(1) ? name : fmt::format("{}*{}", m.to_string(), name);
         else if (m.numerator() == 1)
             term = fmt::format("{}/{}", name, m.denominator().get_str());
@@ -321,6 +342,11 @@ std::string BcifsSolution::print_entry(const AffineForm& f) const {
 std::string print_bcifs_solution(const BcifsSystem& sys, const BcifsSolution& sol) {
     std::string out = fmt::format("bcifs {}: {} unknown entries, {} equations of rank {}, {} free\n",
                                   sys.name, sol.unknowns, sol.equations, sol.rank, sol.free.size());
+    if (sol.tolerance)
+        out +=
+            fmt::format("  solved in floating point with tolerance {:g} (rank checked by QR): the entry at "
+                        "line {}:{} is not exact\n",
+                        *sol.tolerance, sys.inexact_at.line, sys.inexact_at.column);
     for (std::size_t j = 0; j < sys.operators.size(); ++j) {
         const auto& op = sys.operators[j];
         std::vector<std::string> rows;

@@ -1,7 +1,8 @@
 // The BCIFS constraint solver (seed 002 sec. 3): every constraint `P1 * ... * Pk == Q1 * ... * Qm` between
 // products of operators is a set of equations on the operators' unknown entries; with the columns of
 // barycentric operators summing to 1 and the `fix` statements they form one linear system, solved
-// exactly over the rationals (numeric/linear_system.hpp).
+// exactly over the rationals (numeric/linear_system.hpp) — or, when an entry is not exact (sqrt(2)/2),
+// in floating point with a stated tolerance and a rank-revealing check.
 //
 // A product is linear when at most one factor has entries that are not yet numbers. Constraints that
 // are not linear wait until the solution of the others determines all but one of their factors (so a
@@ -53,6 +54,10 @@ struct BcifsSystem {
     std::vector<Operator> operators;
     std::vector<Constraint> constraints;
     std::vector<Fix> fixes;
+    // Set when an entry is not exact (sqrt(2)/2): the system is solved in floating point with this
+    // tolerance (numeric/linear_system.hpp); `inexact_at` is the first such entry.
+    std::optional<double> tolerance;
+    Location inexact_at;
 };
 
 struct BcifsSolution {
@@ -62,6 +67,7 @@ struct BcifsSolution {
     std::vector<std::size_t> free;           // the free variables that are no parameters
     std::vector<int> dof;                    // per cell: the free entries it owns
     std::size_t unknowns = 0, equations = 0, rank = 0;
+    std::optional<double> tolerance; // solved in floating point: entries print as decimals
 
     std::string print_entry(const num::AffineForm& f) const;
 };

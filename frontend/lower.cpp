@@ -82,9 +82,10 @@ struct Closure {
 class Lowering : Inliner<Value> {
 public:
     Lowering(const Program& p, const TypedProgram& typed, const SourceManager& sm, const Limits& limits,
-             Module& m, Diagnostics& d, const ConstantValues* constants = nullptr)
+             Module& m, Diagnostics& d, const ConstantValues* constants = nullptr,
+             std::optional<std::uint64_t> free_entry_seed = std::nullopt)
         : Inliner(limits.max_inline_depth), p_(p), typed_(typed), sm_(sm), limits_(limits), m_(m),
-          g_(m.graph), d_(d), constants_(constants) {}
+          g_(m.graph), d_(d), constants_(constants), free_entry_seed_(free_entry_seed) {}
 
     // The constant stage (consteval.hpp): each constant lowered into this lowering's own graph and read
     // back as exact values or enclosures.
@@ -736,25 +737,44 @@ private:
     num::Rational exact_entry(const Expr& e) {
         const Entry x = entry(closed(e, Context::constant), e.loc);
         if (!x.exact)
-            fail(e.loc, "the entries of a bcifs are exact numbers (integers, decimals, fractions), since its "
-                        "constraints are solved exactly; this one is not");
+            fail(e.loc, "a parameter's range and value are exact numbers (integers, decimals, fractions)");
         return *x.exact;
     }
 
-    // An entry as an affine form over the parameters (variable k is params[k]).
-    num::AffineForm affine_entry(const Expr& e, const std::vector<std::string>& params) {
+    // The tolerance under which a bcifs with inexact entries solves its constraints (linear_system.hpp).
+    static constexpr double inexact_tolerance = 1e-9;
+
+    // A known entry of a bcifs: exact when it can be; else the nearest double, and the system is solved
+    // in floating point with a tolerance (the first such entry is named in `frac solve`).
+    num::Rational system_entry(const Expr& e, BcifsSystem& sys) {
+        const Entry x = entry(closed(e, Context::constant), e.loc);
+        if (x.exact) return *x.exact;
+        return inexact(num::midpoint(x.enclosure), e.loc, sys);
+    }
+    num::Rational inexact(double nearest, Location loc, BcifsSystem& sys) {
+        if (!std::isfinite(nearest)) fail(loc, "an entry of a bcifs is a finite number");
+        if (!sys.tolerance) {
+            sys.tolerance = inexact_tolerance;
+            sys.inexact_at = loc;
+        }
+        return num::Rational::from_double(nearest);
+    }
+
+    // An entry as an affine form over the parameters (variable k is sys.params[k]).
+    num::AffineForm affine_entry(const Expr& e, BcifsSystem& sys) {
+        const std::vector<std::string>& params = sys.params;
         num::AffineForm f;
         if (!mentions(e, params)) {
-            f.constant = exact_entry(e);
+            f.constant = system_entry(e, sys);
             return f;
         }
         if (e.kind == ExprKind::name)
             return num::AffineForm::variable(
                 static_cast<std::size_t>(std::find(params.begin(), params.end(), e.text) - params.begin()));
         if (e.kind == ExprKind::unary && (e.op == Tok::minus || e.op == Tok::plus))
-            return affine_entry(*e.kids[0], params) * num::Rational(e.op == Tok::minus ? -1 : 1);
+            return affine_entry(*e.kids[0], sys) * num::Rational(e.op == Tok::minus ? -1 : 1);
         if (e.kind == ExprKind::binary) {
-            const num::AffineForm a = affine_entry(*e.kids[0], params), b = affine_entry(*e.kids[1], params);
+            const num::AffineForm a = affine_entry(*e.kids[0], sys), b = affine_entry(*e.kids[1], sys);
             if (e.op == Tok::plus) return a + b;
             if (e.op == Tok::minus) return a - b;
             if (e.op == Tok::star && a.is_constant()) return b * a.constant;
@@ -763,6 +783,23 @@ private:
                 return a * (num::Rational(1) / b.constant);
         }
         fail(e.loc, "an entry is affine in the parameters: sums of parameters times numbers");
+    }
+
+    // The solved operator `d.source`.`d.source_cell`.`d.name` of a cell taken from another bcifs
+    // (cell_import.hpp), lowered first when it comes later in the source.
+    num::Matrix<num::Rational> taken_operator(const OperatorDecl& d, const Item& taker) {
+        const Item* source = globals_.at(d.source);
+        if (!typed_.failed.count(source)) guarded([&] { automaton_info(*source); });
+        const auto index = automaton_index_.find(source);
+        if (index == automaton_index_.end())
+            fail(d.loc,
+                 fmt::format("'{}' takes a cell from '{}', which did not compile", taker.name, d.source));
+        const ir::Automaton& a = m_.automata[index->second].automaton;
+        for (const std::vector<ir::Arc>* arcs : {&a.arcs, &a.embeddings})
+            for (const ir::Arc& arc : *arcs)
+                if (a.states[arc.from].name == d.source_cell && arc.label == d.name && arc.op.exact)
+                    return *arc.op.exact;
+        throw InternalError("a taken operator missing from its lowered source");
     }
 
     // The constraint system of a bcifs, from its declaration (the type checker checked every size).
@@ -790,22 +827,23 @@ private:
             o.barycentric =
                 from.kind == ir::Space::Kind::barycentric && to.kind == ir::Space::Kind::barycentric;
             o.entries.assign(o.rows * o.cols, std::nullopt);
-            if (d.value && d.value->kind == ExprKind::matrix) {
+            if (!d.source.empty()) {
+                const num::Matrix<num::Rational> m = taken_operator(d, it);
+                for (std::size_t r = 0; r < o.rows; ++r)
+                    for (std::size_t c = 0; c < o.cols; ++c)
+                        o.entries[r * o.cols + c] = num::AffineForm{m(r, c), {}};
+            } else if (d.value && d.value->kind == ExprKind::matrix) {
                 for (std::size_t r = 0; r < o.rows; ++r)
                     for (std::size_t c = 0; c < o.cols; ++c) {
                         const Expr& x = *d.value->kids[r]->kids[c];
-                        if (!is_unknown(x)) o.entries[r * o.cols + c] = affine_entry(x, sys.params);
+                        if (!is_unknown(x)) o.entries[r * o.cols + c] = affine_entry(x, sys);
                     }
             } else if (d.value) {
                 const ir::Operator m = closed(*d.value, Context::constant).linear->in(0);
-                if (!m.exact)
-                    fail(d.value->loc,
-                         "the entries of a bcifs are exact numbers, since its constraints are solved "
-                         "exactly; this operator is not");
                 for (std::size_t r = 0; r < o.rows; ++r)
                     for (std::size_t c = 0; c < o.cols; ++c) {
                         num::AffineForm f;
-                        f.constant = (*m.exact)(r, c);
+                        f.constant = m.exact ? (*m.exact)(r, c) : inexact(m.nearest(r, c), d.value->loc, sys);
                         o.entries[r * o.cols + c] = f;
                     }
             }
@@ -821,9 +859,11 @@ private:
                     BcifsSystem::Factor x;
                     if (f.constant) {
                         const ir::Operator m = closed(*f.constant, Context::constant).linear->in(0);
-                        if (!m.exact)
-                            fail(f.loc, "a constraint's constant factor is a matrix of exact numbers");
-                        x.constant = *m.exact;
+                        x.constant = num::Matrix<num::Rational>(m.rows(), m.cols());
+                        for (std::size_t r = 0; r < m.rows(); ++r)
+                            for (std::size_t cc = 0; cc < m.cols(); ++cc)
+                                x.constant(r, cc) =
+                                    m.exact ? (*m.exact)(r, cc) : inexact(m.nearest(r, cc), f.loc, sys);
                     } else {
                         x.op = op_index.at({f.cell, f.name});
                     }
@@ -836,7 +876,7 @@ private:
             x.op = op_index.at({f.cell, f.name});
             x.row = static_cast<std::size_t>(f.row);
             x.col = static_cast<std::size_t>(f.col);
-            x.value = affine_entry(*f.value, sys.params);
+            x.value = affine_entry(*f.value, sys);
             x.loc = f.loc;
             sys.fixes.push_back(std::move(x));
         }
@@ -846,7 +886,9 @@ private:
     // Solves the constraints, then gives the free entries and parameters values: a parameter its own,
     // or the middle of its range; the free entries the most uniform operators (bcifs.hpp), then, while
     // the compiler cannot prove the system contractive, those values moved by small steps drawn from a
-    // fixed seed (the same on every machine).
+    // fixed seed (the same on every machine). With --seed N the free entries are drawn from N instead:
+    // the most uniform values moved by up to 1/4 (multiples of 1/64), drawn again until the system is
+    // proven contractive — a random geometry (seed 002 Fig. 11 right) that the seed reproduces.
     void bcifs_info(const Item& it, AutomatonInfo& info,
                     const std::function<std::size_t(const std::string&)>& index) {
         const AutomatonDecl& decl = *it.automaton;
@@ -873,7 +915,9 @@ private:
         }
         const std::vector<num::Rational> uniform = most_uniform_values(sys, *sol, values);
         for (std::size_t v : sol->free) chosen.push_back(v);
-        std::uint64_t state = 1;
+        // The command line's seed, else the model's own (seed N;), else none: the most uniform values.
+        const std::optional<std::uint64_t> seed = free_entry_seed_ ? free_entry_seed_ : b.seed;
+        std::uint64_t state = seed.value_or(0) * 0x2545f4914f6cdd1dull + 1;
         const auto next = [&] { // splitmix64
             std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
             z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -882,12 +926,15 @@ private:
         };
         ir::Automaton& a = info.automaton;
         a.initial = index(initial_state(decl).name);
-        const int attempts = sol->free.empty() ? 1 : 8;
+        const bool seeded = seed && !sol->free.empty();
+        const int attempts = sol->free.empty() ? 1 : seeded ? 64 : 8;
         bool contracts = false;
         for (int attempt = 0; attempt < attempts && !contracts; ++attempt) {
             for (std::size_t k = 0; k < sol->free.size(); ++k)
                 values[sol->free[k]] =
-                    uniform[k] + num::Rational(attempt == 0 ? 0 : static_cast<long>(next() % 9) - 4, 64);
+                    uniform[k] + (seeded         ? num::Rational(static_cast<long>(next() % 33) - 16, 64)
+                                  : attempt == 0 ? num::Rational(0)
+                                                 : num::Rational(static_cast<long>(next() % 9) - 4, 64));
             a.arcs.clear();
             a.embeddings.clear();
             info.arc_locs.clear();
@@ -917,10 +964,15 @@ private:
         }
         if (!contracts)
             fail(it.loc,
-                 fmt::format("the compiler found no values of the {} free entries of '{}' that make it "
-                             "contractive (the most uniform operators and {} nearby); fix some of them "
-                             "(frac solve shows them)",
-                             sol->free.size(), it.name, attempts - 1));
+                 seeded
+                     ? fmt::format("no values drawn from seed {} for the {} free entries of '{}' make it "
+                                   "contractive ({} draws); try another seed, or fix some of them (frac "
+                                   "solve shows them)",
+                                   *seed, sol->free.size(), it.name, attempts)
+                     : fmt::format("the compiler found no values of the {} free entries of '{}' that make "
+                                   "it contractive (the most uniform operators and {} nearby); fix some of "
+                                   "them (frac solve shows them)",
+                                   sol->free.size(), it.name, attempts - 1));
         info.solution = print_bcifs_solution(sys, *sol);
         std::vector<std::string> given;
         for (std::size_t p = 0; p < b.params.size(); ++p)
@@ -931,12 +983,15 @@ private:
             std::vector<std::string> given;
             for (std::size_t v : chosen)
                 given.push_back(fmt::format("{} = {}", sol->variable_names[v], values[v].to_string()));
-            info.solution += fmt::format("  values chosen: {}\n", fmt::join(given, ", "));
+            info.solution +=
+                fmt::format("  values chosen{}: {}\n", seeded ? fmt::format(" (seed {})", *seed) : "",
+                            fmt::join(given, ", "));
         }
         info.dof = sol->dof;
     }
 
     void automaton_info(const Item& it) {
+        if (!automata_lowered_.insert(&it).second) return; // taken cells lower their source first
         const AutomatonDecl& decl = *it.automaton;
         AutomatonInfo info;
         info.name = it.name;
@@ -1236,6 +1291,8 @@ private:
     std::unordered_map<std::string, const Item*> globals_;
     std::unordered_map<const Item*, std::size_t> shape_index_;
     std::unordered_map<const Item*, std::size_t> automaton_index_;
+    std::unordered_set<const Item*> automata_lowered_; // attempted, whether or not they compiled
+    std::optional<std::uint64_t> free_entry_seed_;
     std::vector<const Item*> external_items_; // the automaton of each of m_.externals
     std::unordered_map<const Item*, std::optional<Value>> consts_;
     std::unordered_set<const Item*> failed_consts_;
@@ -1244,8 +1301,9 @@ private:
 } // namespace
 
 void lower(const Program& program, const TypedProgram& typed, const SourceManager& sources,
-           const Limits& limits, Module& out, Diagnostics& diags, const ConstantValues* constants) {
-    Lowering(program, typed, sources, limits, out, diags, constants).run();
+           const Limits& limits, Module& out, Diagnostics& diags, const ConstantValues* constants,
+           std::optional<std::uint64_t> free_entry_seed) {
+    Lowering(program, typed, sources, limits, out, diags, constants, free_entry_seed).run();
 }
 
 void evaluate_constants(const Program& program, const TypedProgram& typed, const SourceManager& sources,

@@ -8,6 +8,7 @@
 #include "frontend/module.hpp"
 
 #include <cstdint>
+#include <optional>
 
 namespace frac::front {
 
@@ -25,8 +26,11 @@ struct ConstantValues;
 
 // `constants`: the values of the constant stage (consteval.hpp), used instead of lowering the
 // definitions of constants again; null: constants are lowered where they are used.
+// `free_entry_seed`: the free entries of every bcifs take values drawn from this seed (reproducible)
+// instead of the most uniform ones (--seed).
 void lower(const Program& program, const TypedProgram& typed, const SourceManager& sources,
-           const Limits& limits, Module& out, Diagnostics& diags, const ConstantValues* constants = nullptr);
+           const Limits& limits, Module& out, Diagnostics& diags, const ConstantValues* constants = nullptr,
+           std::optional<std::uint64_t> free_entry_seed = std::nullopt);
 
 // A map of the plane or space for dynamical systems (fn henon(p) = (...)): the graph nodes of its
 // components applied to the point (Var(0), ..., Var(dimension - 1)), added to out.graph. Throws

@@ -168,7 +168,8 @@ private:
     // ifs NAME in SPACE { [LABEL =] OP [prob P]; ... [primitive = E;] }
     // cifs NAME { state a, b in SPACE; a -> b : [LABEL =] OP [prob P]; initial a; primitive a = E;
     //             project = controls(...); }
-    // bcifs NAME { cell v, e in bary(n); param p [in [lo, hi]] [= v]; subdivide e { T0 [-> c] = OP; }
+    // bcifs NAME { cell v, e in bary(n); cell l = OTHER.e; param p [in [lo, hi]] [= v];
+    //              subdivide e { T0 [-> c] = OP; }
     //              boundary e from v { B0 = OP; } e.B0 * v.T0 == e.T0 * e.B0; fix e.T0[r][c] = E; ... }
     Item automaton(Item it) {
         const std::string word = take().text;
@@ -185,7 +186,7 @@ private:
             if (!at(Tok::kw_in))
                 fail("expected 'in' and the space of the ifs (R2, R3 or bary(n)) after its name");
             take();
-            a->states.push_back({it.name, it.loc, space(), nullptr});
+            a->states.push_back({it.name, it.loc, space(), nullptr, {}, {}, {}});
         }
         expect(Tok::lbrace, "to open the automaton");
         while (!at(Tok::rbrace) && !at(Tok::end)) {
@@ -277,7 +278,7 @@ private:
         } while (accept(Tok::comma));
         expect(Tok::kw_in, space_what);
         const SpaceDecl s = space(min_weights);
-        for (auto& [n, loc] : names) a.states.push_back({n, loc, s, nullptr});
+        for (auto& [n, loc] : names) a.states.push_back({n, loc, s, nullptr, {}, {}, {}});
     }
 
     // The statements only a bcifs has; false when the statement is a common one (initial, primitive,
@@ -286,7 +287,22 @@ private:
         BcifsDecl& b = *a.bcifs;
         if (at_word("cell")) {
             take();
-            state_list(a, "as a cell name", "and the cells' space (bary(n), R2 or R3)", 1);
+            if (at(Tok::ident) && ahead(1).kind == Tok::assign) {
+                // cell l = spline.e;  a cell of another bcifs, with its solved operators
+                StateDecl s;
+                const Token& n = take();
+                s.name = n.text;
+                s.loc = n.loc;
+                take();
+                const Token& from = expect(Tok::ident, "(a bcifs) after '=' (cell l = spline.e)");
+                s.source = from.text;
+                s.source_loc = from.loc;
+                expect(Tok::dot, "after the bcifs (cell l = spline.e)");
+                s.source_cell = expect(Tok::ident, "(a cell of that bcifs) after '.'").text;
+                a.states.push_back(std::move(s));
+            } else {
+                state_list(a, "as a cell name", "and the cells' space (bary(n), R2 or R3)", 1);
+            }
         } else if (at_word("param")) {
             take();
             ParamDecl p;
@@ -351,25 +367,26 @@ private:
             t.cell = cell.text;
             t.loc = cell.loc;
             expect(Tok::assign, "after the cell (topology f = quad(e) split 2 x 2)");
-            const Token& kind = expect(Tok::ident, "(edge or quad)");
+            const Token& kind = expect(Tok::ident, "(edge, quad, triangle or cube)");
             t.kind = kind.text;
             t.kind_loc = kind.loc;
-            if (t.kind != "edge" && t.kind != "quad" && t.kind != "cube")
+            if (t.kind != "edge" && t.kind != "quad" && t.kind != "triangle" && t.kind != "cube")
                 throw CompileError(kind.loc,
                                    fmt::format("no topology '{}': the topologies are edge(v) split n, "
-                                               "quad(e) split n x n and cube(f) split n x n x n",
+                                               "quad(e) split n x n, triangle(e) split n and cube(f) split "
+                                               "n x n x n",
                                                t.kind));
             expect(Tok::lparen, "after the topology");
             const Token& of = expect(Tok::ident, t.kind == "edge"   ? "(the vertex cell)"
-                                                 : t.kind == "quad" ? "(the edge cell)"
-                                                                    : "(the face cell)");
+                                                 : t.kind == "cube" ? "(the face cell)"
+                                                                    : "(the edge cell)");
             t.of = of.text;
             t.of_loc = of.loc;
             expect(Tok::rparen, "after the boundary cell");
             if (!at_word("split")) fail("expected 'split' and the number of parts");
             take();
             t.n = count();
-            const int axes = t.kind == "edge" ? 1 : t.kind == "quad" ? 2 : 3;
+            const int axes = t.kind == "quad" ? 2 : t.kind == "cube" ? 3 : 1;
             for (int axis = 1; axis < axes; ++axis) {
                 if (!at_word("x") && !at(Tok::times) && !at(Tok::star))
                     fail("expected 'x' and the parts along the next axis");
@@ -377,6 +394,14 @@ private:
                 (axis == 1 ? t.m : t.l) = count();
             }
             b.topologies.push_back(std::move(t));
+        } else if (at_word("seed")) {
+            take();
+            const Token& n = expect(Tok::number, "(the seed of the free entries' values) after 'seed'");
+            if (n.text.empty() || n.text.size() > 18 ||
+                n.text.find_first_not_of("0123456789") != std::string::npos)
+                throw CompileError(
+                    n.loc, fmt::format("a seed is a whole number of at most 18 digits, not {}", n.text));
+            b.seed = std::stoull(n.text);
         } else if (at_word("fix")) {
             take();
             FixDecl f;

@@ -1,8 +1,11 @@
 #include "frontend/topology.hpp"
+#include "frontend/cell_import.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <functional>
+#include <map>
 #include <vector>
 
 namespace frac::front {
@@ -50,6 +53,8 @@ public:
                 edge(t, *cell, *of);
             else if (t.kind == "quad")
                 quad(t, *cell, *of);
+            else if (t.kind == "triangle")
+                triangle(t, *cell, *of);
             else
                 cube(t, *cell, *of);
         }
@@ -109,13 +114,15 @@ private:
     static std::string T(int i) { return fmt::format("T{}", i); }
 
     void edge(const TopologyDecl& t, const StateDecl& e, const StateDecl& v) {
-        if (!e.space.barycentric || e.space.n < 2 || !v.space.barycentric || v.space.n != 1) {
-            d_.error(t.loc,
-                     fmt::format("edge(v): the edge is a cell of bary(k), k >= 2, and its vertex a cell of "
-                                 "bary(1); here {} and {}",
-                                 space(e.space), space(v.space)));
+        // Boundary operators the model writes itself may embed any vertex cell (a B-spline's ends depend
+        // on several control points); the generated ones take the first and last point.
+        const bool written = has(e.name, "B0") && has(e.name, "B1") && has(v.name, "T0");
+        if (!sizes_fit(t,
+                       written ||
+                           (e.space.barycentric && e.space.n >= 2 && v.space.barycentric && v.space.n == 1),
+                       "edge(v): the edge is a cell of bary(k), k >= 2, and its vertex a cell of bary(1)",
+                       e.space, "and", v.space))
             return;
-        }
         const std::size_t k = static_cast<std::size_t>(e.space.n);
         op(t, v.name, "T0", v.name, false, selection(1, {0}, t.loc));
         op(t, e.name, "B0", v.name, true, selection(k, {0}, t.loc));
@@ -129,13 +136,12 @@ private:
 
     void quad(const TopologyDecl& t, const StateDecl& f, const StateDecl& e) {
         const int k = e.space.n;
-        if (!e.space.barycentric || !f.space.barycentric || f.space.n != k * k) {
-            d_.error(t.loc,
-                     fmt::format("quad(e): the patch is a cell of bary(k * k) over an edge cell of bary(k); "
-                                 "here {} over {}",
-                                 space(f.space), space(e.space)));
+        if (!sizes_fit(t,
+                       written_boundaries(f, 4) ||
+                           (e.space.barycentric && f.space.barycentric && f.space.n == k * k),
+                       "quad(e): the patch is a cell of bary(k * k) over an edge cell of bary(k)", f.space,
+                       "over", e.space))
             return;
-        }
         if (t.n != t.m) {
             d_.error(t.loc,
                      fmt::format("quad(e) split {} x {}: both sides are the one edge cell '{}', so they "
@@ -143,14 +149,7 @@ private:
                                  t.n, t.m, e.name));
             return;
         }
-        for (int i = 0; i < t.n; ++i)
-            if (!has(e.name, T(i))) {
-                d_.error(t.loc,
-                         fmt::format("quad({}) split {} x {} needs the edge's operators {}.T0 ... {}.T{} (a "
-                                     "topology {} = edge(...) split {} before it)",
-                                     e.name, t.n, t.n, e.name, e.name, t.n - 1, e.name, t.n));
-                return;
-            }
+        if (!edge_pieces(t, e, t.n)) return;
         const auto side = [&](int first, int step) {
             std::vector<std::size_t> ones;
             for (int p = 0; p < k; ++p) ones.push_back(static_cast<std::size_t>(first + p * step));
@@ -181,6 +180,85 @@ private:
             }
     }
 
+    // t in bary(k (k + 1) / 2) over the edge cell e (bary(k), split n): a triangular array of control
+    // points p(i, j), i + j <= k - 1, at index j k - j (j - 1) / 2 + i; B0 the side j = 0 (i increasing),
+    // B1 the side i = 0 (j increasing), B2 the side i + j = k - 1 (from (k-1, 0) to (0, k-1)). The
+    // n^2 sub-triangles: the upward ones U(a, b), a + b <= n - 1, corners (a, b), (a+1, b), (a, b+1)
+    // (in units of 1/n), numbered T0 ... first by b then a; then the downward ones D(a, b), a + b <=
+    // n - 2, whose corners (a+1, b), (a, b+1), (a+1, b+1) take the places of the reference corners
+    // (0, 0), (1, 0), (0, 1) — a reflection, chosen so that every shared side runs the same way in both
+    // sub-triangles (no reversal of the edge cell is needed).
+    void triangle(const TopologyDecl& t, const StateDecl& f, const StateDecl& e) {
+        const int k = e.space.n;
+        if (!sizes_fit(t,
+                       written_boundaries(f, 3) ||
+                           (e.space.barycentric && f.space.barycentric && f.space.n == k * (k + 1) / 2),
+                       "triangle(e): the patch is a cell of bary(k (k + 1) / 2) over an edge cell of bary(k)",
+                       f.space, "over", e.space))
+            return;
+        const int n = t.n;
+        if (!edge_pieces(t, e, n)) return;
+        const auto point = [&](int i, int j) {
+            return static_cast<std::size_t>(j * k - j * (j - 1) / 2 + i);
+        };
+        std::vector<std::size_t> bottom, left, diagonal;
+        for (int p = 0; p < k; ++p) {
+            bottom.push_back(point(p, 0));
+            left.push_back(point(0, p));
+            diagonal.push_back(point(k - 1 - p, p));
+        }
+        const auto rows = static_cast<std::size_t>(f.space.n);
+        op(t, f.name, "B0", e.name, true, selection(rows, bottom, t.loc));
+        op(t, f.name, "B1", e.name, true, selection(rows, left, t.loc));
+        op(t, f.name, "B2", e.name, true, selection(rows, diagonal, t.loc));
+        std::map<std::pair<int, int>, std::string> up, down;
+        int next = 0;
+        for (int b = 0; b < n; ++b)
+            for (int a = 0; a + b < n; ++a) up[{a, b}] = T(next++);
+        for (int b = 0; b + 1 < n; ++b)
+            for (int a = 0; a + b + 1 < n; ++a) down[{a, b}] = T(next++);
+        for (int i = 0; i < next; ++i) op(t, f.name, T(i), f.name, false, nullptr);
+        for (int p = 0; p < n; ++p) {
+            constraint(t, {f.name, "B0"}, {e.name, T(p)}, {f.name, up[{p, 0}]}, {f.name, "B0"});
+            constraint(t, {f.name, "B1"}, {e.name, T(p)}, {f.name, up[{0, p}]}, {f.name, "B1"});
+            constraint(t, {f.name, "B2"}, {e.name, T(p)}, {f.name, up[{n - 1 - p, p}]}, {f.name, "B2"});
+        }
+        for (const auto& [ab, d] : down) {
+            const auto [a, b] = ab;
+            constraint(t, {f.name, d}, {f.name, "B0"}, {f.name, up[{a, b}]}, {f.name, "B2"});
+            constraint(t, {f.name, d}, {f.name, "B1"}, {f.name, up[{a + 1, b}]}, {f.name, "B1"});
+            constraint(t, {f.name, d}, {f.name, "B2"}, {f.name, up[{a, b + 1}]}, {f.name, "B0"});
+        }
+    }
+
+    // `fits`, else an error: the rule the cells' spaces break, and what they are.
+    bool sizes_fit(const TopologyDecl& t, bool fits, const char* rule, const SpaceDecl& cell,
+                   const char* joiner, const SpaceDecl& of) {
+        if (!fits) d_.error(t.loc, fmt::format("{}; here {} {} {}", rule, space(cell), joiner, space(of)));
+        return fits;
+    }
+
+    // Whether the model wrote the boundary operators B0 ... B(count-1) of `cell` (then the topology
+    // only generates the subdivision operators and the constraints, for cells of any size).
+    bool written_boundaries(const StateDecl& cell, int count) const {
+        for (int b = 0; b < count; ++b)
+            if (!has(cell.name, fmt::format("B{}", b))) return false;
+        return true;
+    }
+
+    // Whether the edge cell e has the pieces T0 ... T(n-1) a patch split n along its sides needs; an
+    // error otherwise.
+    bool edge_pieces(const TopologyDecl& t, const StateDecl& e, int n) {
+        for (int i = 0; i < n; ++i)
+            if (!has(e.name, T(i))) {
+                d_.error(t.loc, fmt::format("{}({}) split {} needs the edge's operators {}.T0 ... {}.T{} (a "
+                                            "topology {} = edge(...) split {} before it)",
+                                            t.kind, e.name, n, e.name, e.name, n - 1, e.name, n));
+                return false;
+            }
+        return true;
+    }
+
     // c in bary(k^3) over the face cell f (bary(k^2), split n x n): control point p[k^2 z + k y + x];
     // faces B0 z = 0, B1 z = k-1, B2 y = 0, B3 y = k-1, B4 x = 0, B5 x = k-1, each face's (s, t) the two
     // other axes in increasing order (x, y), (x, z), (y, z), so faces agree along the cube's edges;
@@ -188,13 +266,12 @@ private:
     void cube(const TopologyDecl& t, const StateDecl& c, const StateDecl& f) {
         int k = 1;
         while (k * k < f.space.n) ++k;
-        if (!c.space.barycentric || !f.space.barycentric || k * k != f.space.n || c.space.n != k * k * k) {
-            d_.error(t.loc,
-                     fmt::format("cube(f): the volume is a cell of bary(k^3) over a face cell of bary(k^2); "
-                                 "here {} over {}",
-                                 space(c.space), space(f.space)));
+        if (!sizes_fit(t,
+                       written_boundaries(c, 6) || (c.space.barycentric && f.space.barycentric &&
+                                                    k * k == f.space.n && c.space.n == k * k * k),
+                       "cube(f): the volume is a cell of bary(k^3) over a face cell of bary(k^2)", c.space,
+                       "over", f.space))
             return;
-        }
         const int n = t.n;
         if (t.m != n || t.l != n) {
             d_.error(t.loc,
@@ -281,8 +358,44 @@ private:
 } // namespace
 
 void expand_topology(Program& program, Diagnostics& diags) {
+    // A bcifs that takes cells from another is completed after it (cell_import.hpp): depth first, with
+    // the bcifs being completed marked so that a circle is an error, not a recursion without end.
+    enum class Progress { started, done };
+    std::map<const Item*, Progress> progress;
+    std::map<std::string, Item*> by_name;
     for (Item& it : program.items)
-        if (it.automaton && it.automaton->bcifs) Expander(*it.automaton, diags).run();
+        if (it.automaton && it.automaton->bcifs) by_name.emplace(it.name, &it);
+    std::function<void(Item&)> complete = [&](Item& it) {
+        progress[&it] = Progress::started;
+        import_cells(
+            *it.automaton,
+            [&](const std::string& name, Location loc) -> const Item* {
+                const auto found = by_name.find(name);
+                if (found == by_name.end()) {
+                    diags.error(loc, fmt::format("'{}' is no bcifs (a cell is taken from a bcifs: cell l = "
+                                                 "spline.e;)",
+                                                 name));
+                    return nullptr;
+                }
+                const auto p = progress.find(found->second);
+                if (p != progress.end() && p->second == Progress::started) {
+                    diags.error(loc,
+                                found->second == &it
+                                    ? fmt::format("bcifs '{}' cannot take cells from itself", name)
+                                    : fmt::format("taking cells from '{}' is circular: '{}' takes cells, "
+                                                  "directly or not, from '{}'",
+                                                  name, name, it.name));
+                    return nullptr;
+                }
+                if (p == progress.end()) complete(*found->second);
+                return found->second;
+            },
+            diags);
+        Expander(*it.automaton, diags).run();
+        progress[&it] = Progress::done;
+    };
+    for (Item& it : program.items)
+        if (it.automaton && it.automaton->bcifs && !progress.count(&it)) complete(it);
 }
 
 std::string print_constraints(const Program& program, std::uint32_t file) {
@@ -294,7 +407,10 @@ std::string print_constraints(const Program& program, std::uint32_t file) {
         for (const OperatorDecl& o : b.operators)
             out += fmt::format("  {} {}.{} {} {} = {}{}\n", o.boundary ? "boundary" : "subdivide", o.cell,
                                o.name, o.boundary ? "from" : "->", o.target,
-                               o.value ? print_expr(*o.value) : "?", o.generated ? "  (generated)" : "");
+                               o.value             ? print_expr(*o.value)
+                               : !o.source.empty() ? fmt::format("{}.{}.{}", o.source, o.source_cell, o.name)
+                                                   : "?",
+                               o.generated ? "  (generated)" : "");
         for (const ConstraintDecl& c : b.constraints)
             out += fmt::format("  {} == {}{}\n", print_product(c.left), print_product(c.right),
                                c.origin.empty() ? "" : "  (" + c.origin + ")");

@@ -1,6 +1,9 @@
 #include "numeric/linear_system.hpp"
 
+#include <Eigen/QR>
+
 #include <algorithm>
+#include <cmath>
 #include <iterator>
 
 namespace frac::num {
@@ -43,17 +46,56 @@ void LinearSystem::add(AffineForm form, std::size_t source) {
     equations_.push_back({std::move(form), source});
 }
 
-struct LinearSystem::Reduced {
-    struct Row {
-        AffineForm form;
-        std::vector<std::size_t> sources; // sorted, unique
-    };
-    std::vector<Row> rows;
+namespace {
+
+// The elimination's arithmetic. Exact: every nonzero coefficient is a pivot, the sparsest row the best
+// (least fill-in). Floating point: a coefficient of at most the tolerance is zero, and the largest
+// coefficient of the column is the pivot (partial pivoting), the sparser row on ties.
+struct ExactField {
+    using Value = Rational;
+    static Value from(const Rational& r) { return r; }
+    static Rational to_rational(const Value& v) { return v; }
+    bool is_zero(const Value& v) const { return v.is_zero(); }
+    bool better(const Value&, std::size_t terms, const Value&, std::size_t best_terms) const {
+        return terms < best_terms;
+    }
+};
+
+struct FloatField {
+    using Value = double;
+    double tolerance;
+    static Value from(const Rational& r) { return r.to_double(); }
+    static Rational to_rational(Value v) { return Rational::from_double(v); }
+    bool is_zero(Value v) const { return std::abs(v) <= tolerance; }
+    bool better(Value a, std::size_t terms, Value best, std::size_t best_terms) const {
+        return std::abs(a) > std::abs(best) || (std::abs(a) == std::abs(best) && terms < best_terms);
+    }
+};
+
+template <class Field>
+struct Row {
+    using Value = typename Field::Value;
+    Value constant{};
+    std::map<std::size_t, Value> terms;
+    std::vector<std::size_t> sources; // sorted, unique
+
+    // this += s * o, dropping the coefficients that become zero.
+    void add_scaled(const Row& o, const Value& s, const Field& field) {
+        constant += o.constant * s;
+        for (const auto& [v, a] : o.terms) {
+            auto [it, inserted] = terms.emplace(v, a * s);
+            if (!inserted) it->second += a * s;
+            if (field.is_zero(it->second)) terms.erase(it);
+        }
+    }
+};
+
+template <class Field>
+struct Reduced {
+    std::vector<Row<Field>> rows;
     std::vector<std::optional<std::size_t>> pivot_row; // per variable
     std::optional<std::vector<std::size_t>> conflict;  // the sources of a row 0 = c, c != 0
 };
-
-namespace {
 
 std::vector<std::size_t> merged(const std::vector<std::size_t>& a, const std::vector<std::size_t>& b) {
     std::vector<std::size_t> out;
@@ -62,75 +104,129 @@ std::vector<std::size_t> merged(const std::vector<std::size_t>& a, const std::ve
     return out;
 }
 
-} // namespace
-
-// Gauss-Jordan elimination on sparse rows, taking the columns from the highest variable down, so the
-// pivots are the latest variables that can be pivots (the reduced row echelon form of the columns in
-// reverse order) and the free ones are the earliest.
-LinearSystem::Reduced LinearSystem::reduce(const std::vector<bool>* keep) const {
-    Reduced r;
-    for (const Equation& e : equations_)
-        if ((!keep || (*keep)[e.source]) && (!e.form.is_constant() || !e.form.constant.is_zero()))
-            r.rows.push_back({e.form, {e.source}});
-    r.pivot_row.assign(variables_, std::nullopt);
+// Gauss-Jordan elimination on sparse rows of the equations whose source is in `keep` (every one when
+// null), taking the columns from the highest variable down, so the pivots are the latest variables that
+// can be pivots (the reduced row echelon form of the columns in reverse order) and the free ones are the
+// earliest. When inconsistent, the sources that combined into 0 = c.
+template <class Field>
+Reduced<Field> reduce(const Field& field, const std::vector<LinearSystem::Equation>& equations,
+                      std::size_t variables, const std::vector<bool>* keep) {
+    Reduced<Field> r;
+    for (const LinearSystem::Equation& e : equations) {
+        if (keep && !(*keep)[e.source]) continue;
+        Row<Field> row;
+        row.constant = Field::from(e.form.constant);
+        for (const auto& [v, a] : e.form.terms) {
+            const auto x = Field::from(a);
+            if (!field.is_zero(x)) row.terms.emplace(v, x);
+        }
+        row.sources = {e.source};
+        if (!row.terms.empty() || !field.is_zero(row.constant)) r.rows.push_back(std::move(row));
+    }
+    r.pivot_row.assign(variables, std::nullopt);
     std::vector<bool> is_pivot(r.rows.size(), false);
-    for (std::size_t v = variables_; v-- > 0;) {
+    for (std::size_t v = variables; v-- > 0;) {
         std::optional<std::size_t> best;
-        for (std::size_t i = 0; i < r.rows.size(); ++i)
-            if (!is_pivot[i] && r.rows[i].form.terms.count(v) &&
-                (!best || r.rows[i].form.terms.size() < r.rows[*best].form.terms.size()))
+        for (std::size_t i = 0; i < r.rows.size(); ++i) {
+            if (is_pivot[i]) continue;
+            const auto it = r.rows[i].terms.find(v);
+            if (it == r.rows[i].terms.end()) continue;
+            if (!best || field.better(it->second, r.rows[i].terms.size(), r.rows[*best].terms.at(v),
+                                      r.rows[*best].terms.size()))
                 best = i;
+        }
         if (!best) continue;
-        Reduced::Row& p = r.rows[*best];
-        p.form *= Rational(1) / p.form.terms.at(v);
+        Row<Field>& p = r.rows[*best];
+        const auto inverse = typename Field::Value(1) / p.terms.at(v);
+        p.constant *= inverse;
+        for (auto& [u, a] : p.terms) a *= inverse;
+        p.terms[v] = typename Field::Value(1);
         is_pivot[*best] = true;
         r.pivot_row[v] = *best;
         for (std::size_t i = 0; i < r.rows.size(); ++i) {
             if (i == *best) continue;
-            auto it = r.rows[i].form.terms.find(v);
-            if (it == r.rows[i].form.terms.end()) continue;
-            const Rational factor = -it->second;
-            r.rows[i].form.add_scaled(p.form, factor);
+            auto it = r.rows[i].terms.find(v);
+            if (it == r.rows[i].terms.end()) continue;
+            const auto factor = -it->second;
+            r.rows[i].add_scaled(p, factor, field);
+            r.rows[i].terms.erase(v); // exactly eliminated, whatever rounding left
             r.rows[i].sources = merged(r.rows[i].sources, p.sources);
         }
     }
     for (std::size_t i = 0; i < r.rows.size(); ++i)
-        if (!is_pivot[i] && !r.rows[i].form.constant.is_zero()) {
+        if (!is_pivot[i] && !field.is_zero(r.rows[i].constant)) {
             if (!r.conflict || r.rows[i].sources.size() < r.conflict->size()) r.conflict = r.rows[i].sources;
         }
     return r;
 }
 
-LinearSolution LinearSystem::solve() const {
+// The numerical rank of the equations' coefficient matrix by column-pivoted Householder QR, pivots of at
+// most `tolerance` times the largest counting as zero.
+std::size_t qr_rank(const std::vector<LinearSystem::Equation>& equations, std::size_t variables,
+                    double tolerance) {
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(equations.size()),
+                                              static_cast<Eigen::Index>(variables));
+    for (std::size_t i = 0; i < equations.size(); ++i)
+        for (const auto& [v, x] : equations[i].form.terms)
+            a(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(v)) = x.to_double();
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a);
+    qr.setThreshold(tolerance);
+    return static_cast<std::size_t>(qr.rank());
+}
+
+template <class Field>
+LinearSolution solve_with(const Field& field, const std::vector<LinearSystem::Equation>& equations,
+                          std::size_t variables) {
     LinearSolution s;
-    Reduced r = reduce(nullptr);
+    Reduced<Field> r = reduce(field, equations, variables, nullptr);
     if (r.conflict) {
         // Deletion filter: drop each source whose removal leaves the rest still inconsistent.
         std::size_t sources = 0;
-        for (const Equation& e : equations_) sources = std::max(sources, e.source + 1);
+        for (const LinearSystem::Equation& e : equations) sources = std::max(sources, e.source + 1);
         std::vector<bool> keep(sources, false);
         for (std::size_t k : *r.conflict) keep[k] = true;
         for (std::size_t k : *r.conflict) {
             keep[k] = false;
-            if (!reduce(&keep).conflict) keep[k] = true;
+            if (!reduce(field, equations, variables, &keep).conflict) keep[k] = true;
         }
         s.consistent = false;
         for (std::size_t k = 0; k < sources; ++k)
             if (keep[k]) s.conflict.push_back(k);
         return s;
     }
-    s.values.resize(variables_);
-    for (std::size_t v = 0; v < variables_; ++v) {
+    s.values.resize(variables);
+    for (std::size_t v = 0; v < variables; ++v) {
         if (!r.pivot_row[v]) {
             s.values[v] = AffineForm::variable(v);
             s.free.push_back(v);
             continue;
         }
         // The row is x_v + (the rest) = 0.
-        AffineForm rest = r.rows[*r.pivot_row[v]].form;
-        rest.terms.erase(v);
-        s.values[v] = rest * Rational(-1);
+        const Row<Field>& row = r.rows[*r.pivot_row[v]];
+        AffineForm& x = s.values[v];
+        x.constant = -Field::to_rational(row.constant);
+        for (const auto& [u, a] : row.terms)
+            if (u != v) x.terms.emplace(u, -Field::to_rational(a));
         ++s.rank;
+    }
+    return s;
+}
+
+} // namespace
+
+LinearSolution LinearSystem::solve(std::optional<double> tolerance) const {
+    if (!tolerance) return solve_with(ExactField{}, equations_, variables_);
+    LinearSolution s = solve_with(FloatField{*tolerance}, equations_, variables_);
+    // The dense QR check up to 2.5e7 coefficients (200 MB); larger systems keep the elimination's rank.
+    if (s.consistent && static_cast<double>(equations_.size()) * static_cast<double>(variables_) <= 2.5e7) {
+        s.qr_rank = qr_rank(equations_, variables_, *tolerance);
+        if (s.qr_rank != s.rank) {
+            const std::size_t rank = s.rank, qr = s.qr_rank;
+            s = LinearSolution{};
+            s.ill_conditioned = true;
+            s.rank = rank;
+            s.qr_rank = qr;
+        }
     }
     return s;
 }

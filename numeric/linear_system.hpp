@@ -7,6 +7,13 @@
 // T0 = [[1, a0, b0], [0, a1, b1], [0, 1 - a0 - a1, 1 - b0 - b1]] comes from numbering each operator's
 // entries column by column). An inconsistent system reports a minimal set of sources that conflict:
 // removing any one of them makes the rest consistent.
+//
+// When the coefficients are not exact (a model's entry is sqrt(2)/2), the caller gives a tolerance: the
+// same elimination then runs in floating point with partial pivoting (the largest coefficient of the
+// column), a coefficient or residual of at most the tolerance counts as zero, and the rank it finds is
+// checked against a rank-revealing factorisation (column-pivoted Householder QR, Eigen) at the same
+// tolerance (systems of up to 2.5e7 coefficients); a system whose rank the two do not agree on is
+// reported as ill-conditioned.
 #pragma once
 
 #include "numeric/rational.hpp"
@@ -38,6 +45,10 @@ struct AffineForm {
 
 struct LinearSolution {
     bool consistent = true;
+    // Solved with a tolerance: the elimination and the QR factorisation found different ranks (the
+    // system is too close to a rank change at this tolerance); nothing else is set.
+    bool ill_conditioned = false;
+    std::size_t qr_rank = 0;
     // When inconsistent: a minimal set of conflicting sources, in increasing order.
     std::vector<std::size_t> conflict;
     // When consistent: every variable as an affine form over the free variables (a free variable is
@@ -54,17 +65,16 @@ public:
     std::size_t equations() const { return equations_.size(); }
     // Requires form == 0; `source` names where it came from (for conflicts).
     void add(AffineForm form, std::size_t source);
-    LinearSolution solve() const;
+    // Exact without a tolerance; else in floating point, |x| <= tolerance counting as 0 (the values are
+    // then the doubles found, as exact rationals).
+    LinearSolution solve(std::optional<double> tolerance = std::nullopt) const;
 
-private:
     struct Equation {
         AffineForm form;
         std::size_t source;
     };
-    // Reduces the equations whose source is in `keep` (every source when null); returns the pivot rows
-    // and, when inconsistent, the sources that combined into 0 = c.
-    struct Reduced;
-    Reduced reduce(const std::vector<bool>* keep) const;
+
+private:
     std::size_t variables_;
     std::vector<Equation> equations_;
 };

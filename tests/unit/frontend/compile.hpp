@@ -10,8 +10,9 @@
 
 namespace frac::test {
 
-inline std::unique_ptr<front::Compilation> compile_ok(const std::string& text) {
-    auto c = driver::compile_source("t.frac", text);
+inline std::unique_ptr<front::Compilation> compile_ok(const std::string& text,
+                                                      const driver::CompileOptions& options = {}) {
+    auto c = driver::compile_source("t.frac", text, options);
     if (!c->ok()) FAIL(c->diags.render(c->sources));
     return c;
 }

@@ -7,6 +7,7 @@
 #include "ir/automaton.hpp"
 
 #include <catch2/catch.hpp>
+#include <optional>
 
 using namespace frac;
 using num::Matrix;
@@ -56,8 +57,10 @@ int check_constraints(const front::Compilation& c) {
 
 TEST_CASE("every constraint of the library's bcifs holds exactly on the lowered operators", "[bcifs]") {
     auto c = test::compile_ok("import \"bcifs\";");
-    // fractal_edge 3, quad_patch 3 + 12, bezier_patch 3 + 12, c1_edge 5 of 6 (one has a constant factor).
-    CHECK(check_constraints(*c) == 38);
+    // fractal_edge 3, quad_patch 3 + 12, bezier_patch 3 + 12, c1_edge 5 of 6 (one has a constant factor),
+    // cubic_spline 3, quadratic_spline 3, spline_junction 6, bicubic_patch 3 + 12, triangle_patch 3 + 9,
+    // bezier_triangle 3 + 9.
+    CHECK(check_constraints(*c) == 38 + 51);
 }
 
 TEST_CASE("a patch split 3 x 3 over an edge split 3 shares every side exactly", "[bcifs]") {
@@ -114,9 +117,11 @@ TEST_CASE("bcifs errors are located and specific", "[bcifs]") {
         test::errors_of("bcifs b { " + cells +
                         "param p = 1/2; subdivide e { T0 = [[1, p * p, 0], [0, 0, 0], [0, 1, 1]]; } }"),
         Catch::Contains("affine in the parameters"));
+    // An entry that is not exact: solved in floating point, and this column cannot sum to 1.
     CHECK_THAT(test::errors_of("bcifs b { " + cells +
                                "subdivide e { T0 = [[1, sqrt(2), 0], [0, 0, 0], [0, 1, 1]]; } }"),
-               Catch::Contains("exact numbers"));
+               Catch::Contains("solved in floating point, residuals above 1e-09") &&
+                   Catch::Contains("note: the columns of e.T0 sum to 1"));
     CHECK_THAT(test::errors_of("const m = 2 * ?;"), Catch::Contains("'?'"));
 }
 
@@ -141,4 +146,73 @@ bcifs block {
     CHECK(info.dof == std::vector<int>{0, 6, 72, 702});
     CHECK(info.automaton.arcs.size() == 1 + 2 + 4 + 8);
     CHECK(info.automaton.embeddings.size() == 2 + 4 + 6);
+}
+
+TEST_CASE("seed 004's junction: cells taken from two splines, T^i solved from T^l and T^r", "[bcifs]") {
+    auto c = test::compile_ok("import \"bcifs\";");
+    const ir::Automaton& a = c->module.find_automaton("spline_junction")->automaton;
+    // The paper's T^i with (a, b, c, d, e) = (0.131, 0.2, 0.38, 0.289, 0), (k, l, m, n, p) = (0.11, 0.12,
+    // 0.1, 0.12, 0.55): its first 3 columns are T^l's last 3, its last 2 are T^r's first 2.
+    const Matrix<Rational> ti = *operator_named(a, "i", "Ti").op.exact;
+    const Matrix<Rational> tl = *operator_named(a, "i", "Tl").op.exact;
+    const Matrix<Rational> tr = *operator_named(a, "i", "Tr").op.exact;
+    const std::vector<std::vector<Rational>> paper = {
+        {Rational(1, 8), 0, Rational(131, 1000), Rational(11, 100), 0},
+        {Rational(3, 4), Rational(1, 2), Rational(1, 5), Rational(3, 25), 0},
+        {Rational(1, 8), Rational(1, 2), Rational(19, 50), Rational(1, 10), 0},
+        {0, 0, Rational(289, 1000), Rational(3, 25), Rational(3, 4)},
+        {0, 0, 0, Rational(11, 20), Rational(1, 4)}};
+    for (std::size_t r = 0; r < 5; ++r) {
+        for (std::size_t k = 0; k < 5; ++k) CHECK(ti(r, k) == paper[r][k]);
+        for (std::size_t k = 0; k < 3; ++k) CHECK(ti(r, k) == tl(r, k + 1));
+        for (std::size_t k = 0; k < 2; ++k) CHECK(ti(r, k + 3) == tr(r, k));
+    }
+    // The taken cells keep their source's operators: l's halves are the cubic B-spline's.
+    CHECK(*operator_named(a, "l", "T0").op.exact ==
+          *operator_named(c->module.find_automaton("cubic_spline")->automaton, "e", "T0").op.exact);
+    // The intermediate control points are derived: l's last three, r's first two.
+    const Matrix<Rational> pi = *operator_named(a, "h", "Pi").op.exact;
+    CHECK(pi(0, 0) == 1);
+    CHECK(pi(1, 0) == 3);
+    CHECK(pi(0, 4) == 8);
+    CHECK(pi(1, 4) == 3);
+}
+
+TEST_CASE("a triangle patch split 3 shares every side exactly", "[bcifs]") {
+    auto c = test::compile_ok(R"(
+bcifs tri3 {
+  cell v in bary(1);
+  cell e in bary(3);
+  cell t in bary(6);
+  topology e = edge(v) split 3;
+  topology t = triangle(e) split 3;
+  project = controls((0, 0, 0), (1, 0, 1), (2, 0, 0), (0, 1, 1), (1, 1, 1), (0, 2, 0));
+}
+)");
+    // edge: 2 incidence + 2 adjacency; triangle: 3 sides x 3 pieces + 3 downward x 3 sides.
+    CHECK(check_constraints(*c) == 4 + 9 + 9);
+    const ir::Automaton& a = c->module.find_automaton("tri3")->automaton;
+    CHECK(a.arcs.size() == 1 + 3 + 9);
+}
+
+TEST_CASE("--seed draws the free entries reproducibly, each seed its own", "[bcifs]") {
+    const std::string text = R"(
+bcifs edge {
+  cell v in bary(1);
+  cell e in bary(3);
+  topology e = edge(v) split 2;
+  project = controls((0, 0), (1, 1), (2, 0));
+}
+)";
+    const auto t0 = [&](std::optional<std::uint64_t> seed) {
+        driver::CompileOptions options;
+        options.free_entry_seed = seed;
+        auto c = test::compile_ok(text, options);
+        return *operator_named(c->module.find_automaton("edge")->automaton, "e", "T0").op.exact;
+    };
+    CHECK(t0(7) == t0(7));
+    CHECK_FALSE(t0(7) == t0(8));
+    CHECK_FALSE(t0(7) == t0(std::nullopt));
+    // Most uniform without a seed: 21/64 for every free entry.
+    CHECK(t0(std::nullopt)(0, 1) == Rational(21, 64));
 }

@@ -1,6 +1,8 @@
 #include "numeric/linear_system.hpp"
 
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 
 using frac::num::AffineForm;
 using frac::num::LinearSystem;
@@ -67,4 +69,47 @@ TEST_CASE("redundant equations do not change the rank", "[numeric][linear]") {
     REQUIRE(sol.consistent);
     CHECK(sol.rank == 1);
     CHECK(sol.free == std::vector<std::size_t>{0});
+}
+
+TEST_CASE("with a tolerance, a system is solved in floating point and its rank checked",
+          "[numeric][linear]") {
+    // x0 + x1 = 1, x1 = sqrt(2)/2 rounded; a third equation holds only within rounding.
+    const double s = std::sqrt(2.0) / 2;
+    LinearSystem sys(2);
+    sys.add(form({{0, 1}, {1, 1}}, -1), 0);
+    sys.add(form({{1, 1}}, -Rational::from_double(s)), 1);
+    sys.add(form({{0, 1}}, -Rational::from_double(1 - s + 1e-16)), 2);
+    CHECK_FALSE(sys.solve().consistent); // exactly, the three do not agree
+    const auto sol = sys.solve(1e-9);
+    REQUIRE(sol.consistent);
+    CHECK(sol.rank == 2);
+    CHECK(sol.qr_rank == 2);
+    CHECK(std::abs(sol.values[1].constant.to_double() - s) < 1e-15);
+    CHECK(std::abs(sol.values[0].constant.to_double() - (1 - s)) < 1e-15);
+}
+
+TEST_CASE("with a tolerance, a conflict above it names its minimal set", "[numeric][linear]") {
+    LinearSystem sys(2);
+    sys.add(form({{0, 1}, {1, 1}}, -1), 0);
+    sys.add(form({{1, 1}}, -Rational::from_double(0.5)), 1);
+    sys.add(form({{0, 1}}, -Rational::from_double(0.5 + 1e-6)), 2);
+    sys.add(form({{1, 1}, {0, -1}}), 3); // x1 = x0: with 1 and 2, another conflict of three
+    const auto sol = sys.solve(1e-9);
+    REQUIRE_FALSE(sol.consistent);
+    CHECK(sol.conflict.size() == 3);
+    CHECK(std::find(sol.conflict.begin(), sol.conflict.end(), 2) != sol.conflict.end());
+    CHECK(std::find(sol.conflict.begin(), sol.conflict.end(), 1) != sol.conflict.end());
+}
+
+TEST_CASE("with a tolerance, a rank the QR factorisation does not confirm is ill-conditioned",
+          "[numeric][linear]") {
+    // Rows (1, 1) and (1, 1 + 1.5e-9): elimination keeps the second pivot (1.5e-9 > 1e-9), while the QR's
+    // second pivot, about 1.06e-9, is under 1e-9 times its first (1.41).
+    LinearSystem sys(2);
+    sys.add(form({{0, 1}, {1, 1}}, -1), 0);
+    sys.add(form({{0, 1}, {1, Rational::from_double(1 + 1.5e-9)}}, -1), 1);
+    const auto sol = sys.solve(1e-9);
+    CHECK(sol.ill_conditioned);
+    CHECK(sol.rank == 2);
+    CHECK(sol.qr_rank == 1);
 }
