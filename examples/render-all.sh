@@ -56,6 +56,13 @@ done
 for name in fractal_edge spiky_edge c1_edge quad_patch; do
     "$frac" render "$here/bcifs.frac" "$name" --method chaos --size 512 -o "$out/bcifs_$name.png"
 done
+# Fractal surfaces from bcifs: a patch with seeded facet entries, a closed cube of six rough faces.
+"$frac" mesh "$here/bcifs.frac" rough_patch --depth 6 -o "$out/bcifs_rough_patch.obj"
+"$frac" mesh "$here/bcifs.frac" rough_cube --depth 5 -o "$out/bcifs_rough_cube.stl"
+# Junctions of curves built by different processes, solved from seed 004's constraints.
+for j in spline_junction refined_junction fractal_junction; do
+    "$frac" render "$here/junction.frac" "$j" --method tree --depth 10 -o "$out/$j.svg"
+done
 # Projected-IFS surfaces and curves (stdlib/ifs.frac): quad patches tessellated, a curve as a polyline.
 "$frac" mesh "$here/automata.frac" bicubic_bspline_patch --depth 7 -o "$out/bicubic_bspline_patch.stl"
 "$frac" mesh "$here/automata.frac" biquadratic_bezier_patch --depth 6 -o "$out/biquadratic_bezier_patch.obj"
