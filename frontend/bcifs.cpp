@@ -240,6 +240,7 @@ std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& sys, Diagnostics& di
     out.equations = equations;
     out.rank = solution.rank;
     out.tolerance = sys.tolerance;
+    out.qr_checked = solution.qr_checked;
     for (const Forms& f : forms) out.entries.push_back(substitute_all(f, values));
     // Names: the parameters' own, then one letter per (operator, column) of the free entries.
     out.variable_names.assign(variables, "");
@@ -344,9 +345,14 @@ std::string print_bcifs_solution(const BcifsSystem& sys, const BcifsSolution& so
                                   sys.name, sol.unknowns, sol.equations, sol.rank, sol.free.size());
     if (sol.tolerance)
         out +=
-            fmt::format("  solved in floating point with tolerance {:g} (rank checked by QR): the entry at "
-                        "line {}:{} is not exact\n",
-                        *sol.tolerance, sys.inexact_at.line, sys.inexact_at.column);
+            fmt::format("  solved in floating point with tolerance {:g} ({}): the entry at line {}:{} is not "
+                        "exact\n",
+                        *sol.tolerance,
+                        sol.qr_checked ? "rank checked by QR"
+                                       : fmt::format("rank not checked: the QR check takes systems of up to "
+                                                     "{:g} coefficients",
+                                                     num::qr_check_limit),
+                        sys.inexact_at.line, sys.inexact_at.column);
     for (std::size_t j = 0; j < sys.operators.size(); ++j) {
         const auto& op = sys.operators[j];
         std::vector<std::string> rows;

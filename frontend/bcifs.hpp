@@ -68,6 +68,7 @@ struct BcifsSolution {
     std::vector<int> dof;                    // per cell: the free entries it owns
     std::size_t unknowns = 0, equations = 0, rank = 0;
     std::optional<double> tolerance; // solved in floating point: entries print as decimals
+    bool qr_checked = false;         // and its rank confirmed by QR (linear_system.hpp)
 
     std::string print_entry(const num::AffineForm& f) const;
 };

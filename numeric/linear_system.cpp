@@ -1,6 +1,8 @@
 #include "numeric/linear_system.hpp"
 
-#include <Eigen/QR>
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseQR>
 
 #include <algorithm>
 #include <cmath>
@@ -160,17 +162,22 @@ Reduced<Field> reduce(const Field& field, const std::vector<LinearSystem::Equati
     return r;
 }
 
-// The numerical rank of the equations' coefficient matrix by column-pivoted Householder QR, pivots of at
-// most `tolerance` times the largest counting as zero.
+// The numerical rank of the equations' coefficient matrix by a sparse Householder QR with numerical
+// column pivoting (Eigen's SparseQR, fill-reducing COLAMD order): a column whose remaining norm is at
+// most `tolerance` counts as dependent.
 std::size_t qr_rank(const std::vector<LinearSystem::Equation>& equations, std::size_t variables,
                     double tolerance) {
-    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(equations.size()),
-                                              static_cast<Eigen::Index>(variables));
+    std::vector<Eigen::Triplet<double>> entries;
     for (std::size_t i = 0; i < equations.size(); ++i)
         for (const auto& [v, x] : equations[i].form.terms)
-            a(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(v)) = x.to_double();
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a);
-    qr.setThreshold(tolerance);
+            entries.emplace_back(static_cast<int>(i), static_cast<int>(v), x.to_double());
+    Eigen::SparseMatrix<double> a(static_cast<Eigen::Index>(equations.size()),
+                                  static_cast<Eigen::Index>(variables));
+    a.setFromTriplets(entries.begin(), entries.end());
+    a.makeCompressed();
+    Eigen::SparseQR<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> qr;
+    qr.setPivotThreshold(tolerance);
+    qr.compute(a);
     return static_cast<std::size_t>(qr.rank());
 }
 
@@ -217,8 +224,9 @@ LinearSolution solve_with(const Field& field, const std::vector<LinearSystem::Eq
 LinearSolution LinearSystem::solve(std::optional<double> tolerance) const {
     if (!tolerance) return solve_with(ExactField{}, equations_, variables_);
     LinearSolution s = solve_with(FloatField{*tolerance}, equations_, variables_);
-    // The dense QR check up to 2.5e7 coefficients (200 MB); larger systems keep the elimination's rank.
-    if (s.consistent && static_cast<double>(equations_.size()) * static_cast<double>(variables_) <= 2.5e7) {
+    if (s.consistent &&
+        static_cast<double>(equations_.size()) * static_cast<double>(variables_) <= qr_check_limit) {
+        s.qr_checked = true;
         s.qr_rank = qr_rank(equations_, variables_, *tolerance);
         if (s.qr_rank != s.rank) {
             const std::size_t rank = s.rank, qr = s.qr_rank;

@@ -83,6 +83,7 @@ TEST_CASE("with a tolerance, a system is solved in floating point and its rank c
     const auto sol = sys.solve(1e-9);
     REQUIRE(sol.consistent);
     CHECK(sol.rank == 2);
+    CHECK(sol.qr_checked);
     CHECK(sol.qr_rank == 2);
     CHECK(std::abs(sol.values[1].constant.to_double() - s) < 1e-15);
     CHECK(std::abs(sol.values[0].constant.to_double() - (1 - s)) < 1e-15);
@@ -103,11 +104,11 @@ TEST_CASE("with a tolerance, a conflict above it names its minimal set", "[numer
 
 TEST_CASE("with a tolerance, a rank the QR factorisation does not confirm is ill-conditioned",
           "[numeric][linear]") {
-    // Rows (1, 1) and (1, 1 + 1.5e-9): elimination keeps the second pivot (1.5e-9 > 1e-9), while the QR's
-    // second pivot, about 1.06e-9, is under 1e-9 times its first (1.41).
+    // Rows (1, 1) and (1, 1 + 1.2e-9): elimination keeps the second pivot (1.2e-9 > 1e-9), while the
+    // QR's second diagonal entry, 1.2e-9 / sqrt(2) = 0.85e-9, is under the tolerance.
     LinearSystem sys(2);
     sys.add(form({{0, 1}, {1, 1}}, -1), 0);
-    sys.add(form({{0, 1}, {1, Rational::from_double(1 + 1.5e-9)}}, -1), 1);
+    sys.add(form({{0, 1}, {1, Rational::from_double(1 + 1.2e-9)}}, -1), 1);
     const auto sol = sys.solve(1e-9);
     CHECK(sol.ill_conditioned);
     CHECK(sol.rank == 2);
