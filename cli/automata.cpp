@@ -242,9 +242,39 @@ int render_map(front::Compilation& c, const front::Item& map, const RenderOption
     return 0;
 }
 
+namespace {
+
+// Checks a surface's mesh, says what it is on stderr (`how`, when not empty, first), and writes it.
+int report_surface_mesh(const front::AutomatonInfo& info, const rt::Mesh& mesh, const std::string& how,
+                        const MeshOptions& o) {
+    const rt::MeshCheck check = rt::check_mesh(mesh);
+    const bool ok = check.manifold && check.oriented && check.edges > 0;
+    if (!how.empty())
+        std::cerr << fmt::format("{}: {}; depth {}: {} vertices\n", info.name, how, o.depth,
+                                 mesh.vertices.size());
+    std::cerr << fmt::format("{}: {} triangles, {} rim edges; {}, Euler characteristic {}, {} components\n",
+                             info.name, mesh.triangles.size(), check.boundary_edges,
+                             ok ? "manifold and oriented" : "NOT manifold: " + check.problem, check.euler,
+                             check.components);
+    write_mesh_file(mesh, o.output, o.force);
+    return ok ? 0 : 1;
+}
+
+} // namespace
+
 int mesh_automaton(const front::AutomatonInfo& info, const MeshOptions& o) {
     if (o.depth > 24) throw UsageError("--depth of a tessellation is at most 24");
     const ir::Automaton& a = info.automaton;
+    // A triangle patch (a bcifs's triangle topology) has its own grid.
+    for (const ir::TrianglePatch& patch : a.triangle_patches)
+        if (patch.state == a.initial && o.layout.empty() && o.cells.empty()) {
+            if (ends_with(o.output, ".svg"))
+                throw UsageError(fmt::format("{} is a surface: write it as .stl, .obj or .ply", info.name));
+            const rt::Mesh mesh =
+                runtime_job([&] { return rt::tessellate_triangle_patch(a, patch, o.depth); });
+            return report_surface_mesh(info, mesh,
+                                       fmt::format("a triangle patch split {} (topology)", patch.n), o);
+        }
     const rt::LayoutRequest request = layout_request(o);
     // An initial state that is never reached again and is no grid itself: a set of patches.
     bool set_of_patches = request.n_s == 0 && request.cells.empty();
@@ -280,15 +310,7 @@ int mesh_automaton(const front::AutomatonInfo& info, const MeshOptions& o) {
     }
     if (ends_with(o.output, ".svg"))
         throw UsageError(fmt::format("{} is a surface: write it as .stl, .obj or .ply", info.name));
-    const rt::Mesh mesh = rt::surface_mesh(t);
-    const rt::MeshCheck check = rt::check_mesh(mesh);
-    const bool ok = check.manifold && check.oriented && check.edges > 0;
-    std::cerr << fmt::format("{}: {} triangles, {} rim edges; {}, Euler characteristic {}, {} components\n",
-                             info.name, mesh.triangles.size(), check.boundary_edges,
-                             ok ? "manifold and oriented" : "NOT manifold: " + check.problem, check.euler,
-                             check.components);
-    write_mesh_file(mesh, o.output, o.force);
-    return ok ? 0 : 1;
+    return report_surface_mesh(info, rt::surface_mesh(t), "", o);
 }
 
 int automaton_dimension(const front::AutomatonInfo& info, int from, int to) {

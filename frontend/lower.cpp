@@ -802,6 +802,34 @@ private:
         throw InternalError("a taken operator missing from its lowered source");
     }
 
+    // The layout of every triangle topology whose boundary operators it generated (so its corners are
+    // the control points p(0, 0), p(k-1, 0), p(0, k-1)), for the tessellation.
+    static void triangle_patches(const BcifsDecl& b, ir::Automaton& a,
+                                 const std::function<std::size_t(const std::string&)>& index) {
+        for (const TopologyDecl& t : b.topologies) {
+            if (t.kind != "triangle") continue;
+            const bool generated =
+                std::all_of(b.operators.begin(), b.operators.end(), [&](const OperatorDecl& o) {
+                    return o.cell != t.cell || !o.boundary || o.generated;
+                });
+            if (!generated) continue;
+            ir::TrianglePatch p;
+            p.state = index(t.cell);
+            p.n = t.n;
+            const std::size_t m = static_cast<std::size_t>(a.states[p.state].space.coordinates());
+            std::size_t k = 1;
+            while (k * (k + 1) / 2 < m) ++k;
+            p.corners = {0, k - 1, m - 1};
+            const std::size_t ups = static_cast<std::size_t>(t.n * (t.n + 1) / 2);
+            for (std::size_t i = 0; i < static_cast<std::size_t>(t.n * t.n); ++i)
+                for (std::size_t j = 0; j < a.arcs.size(); ++j)
+                    if (a.arcs[j].from == p.state && a.arcs[j].label == fmt::format("T{}", i))
+                        (i < ups ? p.up : p.down).push_back(j);
+            if (p.up.size() + p.down.size() == static_cast<std::size_t>(t.n * t.n))
+                a.triangle_patches.push_back(p);
+        }
+    }
+
     // The constraint system of a bcifs, from its declaration (the type checker checked every size).
     BcifsSystem bcifs_system(const Item& it, const std::function<std::size_t(const std::string&)>& index) {
         const AutomatonDecl& decl = *it.automaton;
@@ -962,6 +990,7 @@ private:
             }
             contracts = attempts == 1 || ir::prove_contractive(a).proven;
         }
+        triangle_patches(b, a, index);
         if (!contracts)
             fail(it.loc,
                  seeded

@@ -21,6 +21,7 @@
 #include "numeric/matrix.hpp"
 #include "numeric/rational.hpp"
 
+#include <array>
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -79,6 +80,18 @@ struct Arc {
     std::string label;                 // the name written in the model (T0, f1, ...), may be empty
 };
 
+// A cell split as a triangle patch (a bcifs's `topology t = triangle(e) split n`, frontend/topology.hpp):
+// its control points p(i, j), i + j <= k - 1, and its arcs to the upward sub-triangles U(a, b) (corners
+// (a, b), (a+1, b), (a, b+1) in units of 1/n) and the downward ones D(a, b), whose reference corners
+// (0, 0), (1, 0), (0, 1) sit at (a+1, b), (a, b+1), (a+1, b+1). The tessellation of triangle patches
+// (runtime/automata/surface.hpp) follows it.
+struct TrianglePatch {
+    std::size_t state = 0;
+    int n = 2;
+    std::vector<std::size_t> up, down;  // arc indices, U(a, b) and D(a, b) by b, then a
+    std::array<std::size_t, 3> corners; // the weights at the corners (0, 0), (1, 0), (0, 1)
+};
+
 struct Automaton {
     std::string name;
     std::vector<State> states;
@@ -91,6 +104,7 @@ struct Automaton {
     // attractor inside a higher one's and are no part of the union that defines an attractor, so they
     // are kept apart from the arcs (junctions, shared boundaries and meshes use them).
     std::vector<Arc> embeddings;
+    std::vector<TrianglePatch> triangle_patches;
 
     // The arcs leaving state s, in model order.
     std::vector<std::size_t> arcs_from(std::size_t s) const;

@@ -651,4 +651,95 @@ void write_polyline_obj(const Tessellation& t, const std::string& path) {
     if (!os) throw std::runtime_error(fmt::format("cannot write {}", path));
 }
 
+Mesh tessellate_triangle_patch(const ir::Automaton& a, const ir::TrianglePatch& patch, int depth) {
+    require_well_formed(a);
+    if (patch.state != a.initial)
+        throw std::invalid_argument(fmt::format("{}: the triangle patch {} is not the initial state", a.name,
+                                                a.states[patch.state].name));
+    if (depth < 0 || depth > 24)
+        throw std::invalid_argument(fmt::format("tessellation depth {} is outside [0, 24]", depth));
+    const double triangles = std::pow(static_cast<double>(patch.n), 2.0 * depth);
+    if (triangles > static_cast<double>(std::uint64_t{1} << 26))
+        throw std::invalid_argument(fmt::format(
+            "a tessellation at depth {} would have {:.3g} triangles (at most 2^26)", depth, triangles));
+    const int out_dim = a.output_dimension();
+    if (out_dim > 3)
+        throw std::invalid_argument(
+            fmt::format("{} is drawn in R{}: a mesh needs R3 or less", a.name, out_dim));
+    // Global grid points (i, j), i + j <= N, N = n^p, numbered row by row (j), then i.
+    const Index side = power(static_cast<std::size_t>(patch.n), depth);
+    const auto vertex_index = [&](Index i, Index j) {
+        return static_cast<std::size_t>(j * (side + 1) - j * (j - 1) / 2 + i);
+    };
+    Mesh mesh;
+    mesh.vertices.resize(static_cast<std::size_t>((side + 1) * (side + 2) / 2));
+    std::vector<std::uint8_t> written(mesh.vertices.size(), 0);
+    mesh.triangles.reserve(static_cast<std::size_t>(triangles));
+
+    // A node's local corner (x, y) of its reference triangle sits at O + R (x, y) in the global grid,
+    // x, y in units of the node's side h; its composite P T_1 ... T_d maps its weights to the output.
+    struct Frame {
+        Index o[2];
+        Index r[2][2];
+    };
+    const std::size_t m = static_cast<std::size_t>(a.states[patch.state].space.coordinates());
+    const Matrix<double> out = output_matrix(a);
+    std::vector<std::vector<double>> composite(static_cast<std::size_t>(depth) + 1,
+                                               std::vector<double>(out.rows() * m, 0.0));
+    for (std::size_t r = 0; r < out.rows(); ++r)
+        for (std::size_t c = 0; c < m; ++c) composite[0][r * m + c] = out(r, c);
+    const auto walk = [&](auto&& self, int level, Index h, const Frame& f) -> void {
+        const double* mq = composite[static_cast<std::size_t>(level)].data();
+        if (level == depth) {
+            // The three corners: the composite's columns at the corner weights, each grid point once.
+            const Index local[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+            std::array<std::uint32_t, 3> tri{};
+            for (int c = 0; c < 3; ++c) {
+                const Index i = f.o[0] + f.r[0][0] * local[c][0] + f.r[0][1] * local[c][1];
+                const Index j = f.o[1] + f.r[1][0] * local[c][0] + f.r[1][1] * local[c][1];
+                const std::size_t v = vertex_index(i, j);
+                tri[static_cast<std::size_t>(c)] = static_cast<std::uint32_t>(v);
+                if (written[v]) continue;
+                written[v] = 1;
+                for (int r = 0; r < std::min(out_dim, 3); ++r)
+                    mesh.vertices[v][static_cast<std::size_t>(r)] =
+                        mq[static_cast<std::size_t>(r) * m + patch.corners[static_cast<std::size_t>(c)]];
+            }
+            // Counter-clockwise in the parameter plane: a reflected frame swaps two corners.
+            if (f.r[0][0] * f.r[1][1] - f.r[0][1] * f.r[1][0] < 0) std::swap(tri[1], tri[2]);
+            mesh.triangles.push_back(tri);
+            return;
+        }
+        const Index child = h / patch.n;
+        double* next = composite[static_cast<std::size_t>(level) + 1].data();
+        const auto descend = [&](std::size_t arc, Index x, Index y, bool reflected) {
+            const Matrix<double>& t = a.arcs[arc].op.nearest;
+            for (std::size_t r = 0; r < out.rows(); ++r)
+                for (std::size_t c = 0; c < m; ++c) {
+                    double sum = 0;
+                    for (std::size_t k = 0; k < m; ++k) sum += mq[r * m + k] * t(k, c);
+                    next[r * m + c] = sum;
+                }
+            Frame g;
+            g.o[0] = f.o[0] + f.r[0][0] * x + f.r[0][1] * y;
+            g.o[1] = f.o[1] + f.r[1][0] * x + f.r[1][1] * y;
+            // A downward child's x runs along (-1, 1) and its y along (0, 1) of its parent's frame.
+            for (int row = 0; row < 2; ++row) {
+                g.r[row][0] = reflected ? f.r[row][1] - f.r[row][0] : f.r[row][0];
+                g.r[row][1] = f.r[row][1];
+            }
+            self(self, level + 1, child, g);
+        };
+        std::size_t k = 0;
+        for (Index b = 0; b < patch.n; ++b)
+            for (Index c = 0; b + c < patch.n; ++c) descend(patch.up[k++], c * child, b * child, false);
+        k = 0;
+        for (Index b = 0; b + 1 < patch.n; ++b)
+            for (Index c = 0; b + c + 1 < patch.n; ++c)
+                descend(patch.down[k++], (c + 1) * child, b * child, true);
+    };
+    walk(walk, 0, side, Frame{{0, 0}, {{1, 0}, {0, 1}}});
+    return mesh;
+}
+
 } // namespace frac::rt

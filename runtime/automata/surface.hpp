@@ -85,6 +85,12 @@ Tessellation tessellate(const ir::Automaton& a, const SurfaceLayout& layout, int
 // Two triangles per grid square, counter-clockwise around ds x dt. Throws for a curve.
 Mesh surface_mesh(const Tessellation& t);
 
+// A triangle patch (ir::TrianglePatch, the automaton's initial state) tessellated to depth p: the
+// (N + 1)(N + 2) / 2 vertices of its grid, N = n^p, each computed once from the first sub-triangle that
+// reaches it (so shared sides are bit-identical), and its n^(2p) triangles, counter-clockwise in the
+// parameter plane (a reflected sub-triangle's corners swapped). At most 2^26 triangles.
+Mesh tessellate_triangle_patch(const ir::Automaton& a, const ir::TrianglePatch& patch, int depth);
+
 // A surface of several patches: each arc of the initial state leads to a patch state (laid out by
 // infer_layout from there), drawn through the arc's operator (and the projection). Each patch is
 // tessellated to depth p; a side of one patch whose vertices all coincide with a side of another (in

@@ -1,12 +1,15 @@
 // Tessellation of projected-IFS patches and curves (runtime/automata/surface.hpp): the bicubic
 // B-spline patch against direct tensor-product evaluation, shared sides, cracks, layouts.
+#include "driver/pipeline.hpp"
 #include "runtime/automata/surface.hpp"
 #include "runtime/automata/tabulate.hpp"
 #include "tests/unit/automata_examples.hpp"
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 
 using namespace frac;
 using namespace frac::test;
@@ -320,4 +323,51 @@ TEST_CASE("layouts that cannot be tessellated are refused clearly", "[automata][
     rt::SurfaceLayout bad = layout;
     bad.states[0]->cells.pop_back();
     CHECK_THROWS_WITH(rt::check_layout(a, bad), Catch::Contains("3 cells for 2 x 2 sub-cells and 4 arcs"));
+}
+
+TEST_CASE("a triangle patch: the quadratic Bezier triangle's vertices, shared sides, one sheet",
+          "[automata][surface]") {
+    // The library's bezier_triangle: a bcifs whose triangle topology the compiler records, its
+    // de Casteljau operators given. Vertex (i, j) of the depth-3 grid is the Bezier triangle at
+    // (u, v) = (i, j) / 8: sum over control points p(a, b) of 2! / (c! a! b!) w^c u^a v^b, w = 1 - u - v.
+    const auto c = driver::compile_source("t.frac", "import \"bcifs\";");
+    REQUIRE(c->ok());
+    const ir::Automaton& a = c->module.find_automaton("bezier_triangle")->automaton;
+    REQUIRE(a.triangle_patches.size() == 1);
+    const int depth = 3, side = 8;
+    const rt::Mesh mesh = rt::tessellate_triangle_patch(a, a.triangle_patches[0], depth);
+    CHECK(mesh.vertices.size() == static_cast<std::size_t>((side + 1) * (side + 2) / 2));
+    CHECK(mesh.triangles.size() == 64);
+    const double controls[6][3] = {{0, 0, 0}, {1, 0, 1}, {2, 0, 0}, {0, 1, 1}, {1, 1, 1}, {0, 2, 0}};
+    const int ai[6] = {0, 1, 2, 0, 1, 0}, bi[6] = {0, 0, 0, 1, 1, 2};
+    double worst = 0;
+    std::size_t v = 0;
+    for (int j = 0; j <= side; ++j)
+        for (int i = 0; i + j <= side; ++i, ++v) {
+            const double u = i / 8.0, t = j / 8.0, w = 1 - u - t;
+            for (int r = 0; r < 3; ++r) {
+                double x = 0;
+                for (int p = 0; p < 6; ++p) {
+                    const int cw = 2 - ai[p] - bi[p];
+                    const double multinomial =
+                        2.0 / ((cw == 2 ? 2 : 1) * (ai[p] == 2 ? 2 : 1) * (bi[p] == 2 ? 2 : 1));
+                    x += controls[p][r] * multinomial * std::pow(w, cw) * std::pow(u, ai[p]) *
+                         std::pow(t, bi[p]);
+                }
+                worst = std::max(worst, std::abs(x - mesh.vertices[v][static_cast<std::size_t>(r)]));
+            }
+        }
+    CHECK(worst < 1e-12);
+    // One oriented sheet: every inner edge shared by two triangles running it in opposite directions.
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+    for (const auto& tri : mesh.triangles)
+        for (int e = 0; e < 3; ++e)
+            ++edges[{tri[static_cast<std::size_t>(e)], tri[static_cast<std::size_t>((e + 1) % 3)]}];
+    int inner = 0, rim = 0;
+    for (const auto& [edge, count] : edges) {
+        CHECK(count == 1);
+        (edges.count({edge.second, edge.first}) ? inner : rim) += 1;
+    }
+    CHECK(rim == 3 * side);
+    CHECK(inner % 2 == 0);
 }
