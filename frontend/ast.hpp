@@ -142,9 +142,10 @@ struct ParamDecl {
 
 // topology e = edge(v) split n;  topology f = quad(e) split n x n;  (frontend/topology.hpp)
 struct TopologyDecl {
-    std::string cell, kind, of; // kind: edge, quad or cube; `of`: the boundary cell
+    std::string cell, kind, of; // kind: edge, quad, triangle or cube; `of`: the boundary cell
+    std::string across;         // quad(e, g): the edge cell of the left and right sides (else `of`)
     int n = 2, m = 1, l = 1;
-    Location loc, kind_loc, of_loc;
+    Location loc, kind_loc, of_loc, across_loc;
 };
 
 struct BcifsDecl {

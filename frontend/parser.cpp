@@ -382,6 +382,11 @@ private:
                                                                     : "(the edge cell)");
             t.of = of.text;
             t.of_loc = of.loc;
+            if (t.kind == "quad" && accept(Tok::comma)) {
+                const Token& g = expect(Tok::ident, "(the edge cell of the left and right sides)");
+                t.across = g.text;
+                t.across_loc = g.loc;
+            }
             expect(Tok::rparen, "after the boundary cell");
             if (!at_word("split")) fail("expected 'split' and the number of parts");
             take();

@@ -45,15 +45,17 @@ public:
             const StateDecl* cell = find_cell(t.cell, t.loc);
             const StateDecl* of = find_cell(t.of, t.of_loc);
             if (!cell || !of || d_.error_count() != errors) continue;
-            origin_ = fmt::format("topology {} = {}({}) split {}", t.cell, t.kind, t.of,
+            origin_ = fmt::format("topology {} = {}({}{}) split {}", t.cell, t.kind, t.of,
+                                  t.across.empty() ? "" : ", " + t.across,
                                   t.kind == "cube"   ? fmt::format("{} x {} x {}", t.n, t.m, t.l)
                                   : t.kind == "quad" ? fmt::format("{} x {}", t.n, t.m)
                                                      : std::to_string(t.n));
             if (t.kind == "edge")
                 edge(t, *cell, *of);
-            else if (t.kind == "quad")
-                quad(t, *cell, *of);
-            else if (t.kind == "triangle")
+            else if (t.kind == "quad") {
+                const StateDecl* across = t.across.empty() ? of : find_cell(t.across, t.across_loc);
+                if (across) quad(t, *cell, *of, *across);
+            } else if (t.kind == "triangle")
                 triangle(t, *cell, *of);
             else
                 cube(t, *cell, *of);
@@ -134,47 +136,54 @@ private:
             constraint(t, {e.name, T(i)}, {e.name, "B1"}, {e.name, T(i + 1)}, {e.name, "B0"});
     }
 
-    void quad(const TopologyDecl& t, const StateDecl& f, const StateDecl& e) {
-        const int k = e.space.n;
+    void quad(const TopologyDecl& t, const StateDecl& f, const StateDecl& e, const StateDecl& g) {
+        // f in bary(k * h): k points along a row (the bottom and top sides, edge cell e split n), h rows
+        // (the left and right sides, edge cell g split m); point p[k * row + column].
+        const int k = e.space.n, h = g.space.n;
         if (!sizes_fit(t,
-                       written_boundaries(f, 4) ||
-                           (e.space.barycentric && f.space.barycentric && f.space.n == k * k),
-                       "quad(e): the patch is a cell of bary(k * k) over an edge cell of bary(k)", f.space,
-                       "over", e.space))
+                       written_boundaries(f, 4) || (e.space.barycentric && g.space.barycentric &&
+                                                    f.space.barycentric && f.space.n == k * h),
+                       &e == &g ? "quad(e): the patch is a cell of bary(k * k) over an edge cell of bary(k)"
+                                : "quad(e, g): the patch is a cell of bary(k * h) over edge cells of bary(k) "
+                                  "and bary(h)",
+                       f.space, "over", e.space))
             return;
-        if (t.n != t.m) {
+        if (&e == &g && t.n != t.m) {
             d_.error(t.loc,
                      fmt::format("quad(e) split {} x {}: both sides are the one edge cell '{}', so they "
-                                 "split alike (n x n)",
+                                 "split alike (n x n); quad(e, g) takes a second edge cell for the left and "
+                                 "right sides",
                                  t.n, t.m, e.name));
             return;
         }
-        if (!edge_pieces(t, e, t.n)) return;
-        const auto side = [&](int first, int step) {
+        if (!edge_pieces(t, e, t.n) || !edge_pieces(t, g, t.m)) return;
+        const auto side = [&](int first, int step, int count) {
             std::vector<std::size_t> ones;
-            for (int p = 0; p < k; ++p) ones.push_back(static_cast<std::size_t>(first + p * step));
-            return selection(static_cast<std::size_t>(k * k), ones, t.loc);
+            for (int p = 0; p < count; ++p) ones.push_back(static_cast<std::size_t>(first + p * step));
+            return selection(static_cast<std::size_t>(k * h), ones, t.loc);
         };
-        op(t, f.name, "B0", e.name, true, side(0, 1));           // bottom row
-        op(t, f.name, "B1", e.name, true, side(0, k));           // left column
-        op(t, f.name, "B2", e.name, true, side(k - 1, k));       // right column
-        op(t, f.name, "B3", e.name, true, side(k * (k - 1), 1)); // top row
-        const int n = t.n;
+        op(t, f.name, "B0", e.name, true, side(0, 1, k));           // bottom row
+        op(t, f.name, "B1", g.name, true, side(0, k, h));           // left column
+        op(t, f.name, "B2", g.name, true, side(k - 1, k, h));       // right column
+        op(t, f.name, "B3", e.name, true, side(k * (h - 1), 1, k)); // top row
+        const int n = t.n, m = t.m;
         const auto sub = [&](int i, int j) { return T(i + n * j); };
-        for (int j = 0; j < n; ++j)
+        for (int j = 0; j < m; ++j)
             for (int i = 0; i < n; ++i) op(t, f.name, sub(i, j), f.name, false, nullptr);
         for (int i = 0; i < n; ++i) {
             constraint(t, {f.name, "B0"}, {e.name, T(i)}, {f.name, sub(i, 0)}, {f.name, "B0"});
-            constraint(t, {f.name, "B3"}, {e.name, T(i)}, {f.name, sub(i, n - 1)}, {f.name, "B3"});
-            constraint(t, {f.name, "B1"}, {e.name, T(i)}, {f.name, sub(0, i)}, {f.name, "B1"});
-            constraint(t, {f.name, "B2"}, {e.name, T(i)}, {f.name, sub(n - 1, i)}, {f.name, "B2"});
+            constraint(t, {f.name, "B3"}, {e.name, T(i)}, {f.name, sub(i, m - 1)}, {f.name, "B3"});
         }
-        for (int j = 0; j < n; ++j)
+        for (int j = 0; j < m; ++j) {
+            constraint(t, {f.name, "B1"}, {g.name, T(j)}, {f.name, sub(0, j)}, {f.name, "B1"});
+            constraint(t, {f.name, "B2"}, {g.name, T(j)}, {f.name, sub(n - 1, j)}, {f.name, "B2"});
+        }
+        for (int j = 0; j < m; ++j)
             for (int i = 0; i < n; ++i) {
                 if (i + 1 < n)
                     constraint(t, {f.name, sub(i, j)}, {f.name, "B2"}, {f.name, sub(i + 1, j)},
                                {f.name, "B1"});
-                if (j + 1 < n)
+                if (j + 1 < m)
                     constraint(t, {f.name, sub(i, j)}, {f.name, "B3"}, {f.name, sub(i, j + 1)},
                                {f.name, "B0"});
             }

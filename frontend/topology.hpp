@@ -6,6 +6,9 @@
 //       boundary e from v { B0 = the first control point; B1 = the last; }, T0 ... T(n-1) unknown,
 //       v.T0 = [[1]]; incidence e.B0 * v.T0 == e.T0 * e.B0, e.B1 * v.T0 == e.T(n-1) * e.B1;
 //       adjacency e.Ti * e.B1 == e.T(i+1) * e.B0.
+//   topology f = quad(e, g) split n x m;  two edge cells: e (bary(k), split n) for the bottom and top
+//       rows, g (bary(h), split m) for the left and right columns, f in bary(k * h), h rows of k points;
+//       quad(e) is quad(e, e) (then n = m). The rest as for the square patch:
 //   topology f = quad(e) split n x n;   f in bary(k * k): a grid of control points p[k * row + column],
 //       bounded by the edge cell e (bary(k), split into n): B0 the bottom row, B1 the left column, B2 the
 //       right column, B3 the top row (each from its first to its last point); sub-patch T(i + n j) is the

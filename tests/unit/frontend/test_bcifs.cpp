@@ -216,3 +216,26 @@ bcifs edge {
     // Most uniform without a seed: 21/64 for every free entry.
     CHECK(t0(std::nullopt)(0, 1) == Rational(21, 64));
 }
+
+TEST_CASE("a quad patch over two edge cells, split 3 x 2, shares every side exactly", "[bcifs]") {
+    auto c = test::compile_ok(R"(
+bcifs patch32 {
+  cell v in bary(1);
+  cell e in bary(3);
+  cell g in bary(4);
+  cell f in bary(12);
+  topology e = edge(v) split 3;
+  topology g = edge(v) split 2;
+  topology f = quad(e, g) split 3 x 2;
+  project = controls((0,0,0), (1,0,1), (2,0,0), (0,1,1), (1,1,2), (2,1,1),
+                     (0,2,1), (1,2,2), (2,2,1), (0,3,0), (1,3,1), (2,3,0));
+}
+)");
+    // e: 2 + 2, g: 2 + 1; patch: 2 x 3 + 2 x 2 incidence, 2 x 2 + 3 x 1 adjacency.
+    CHECK(check_constraints(*c) == 4 + 3 + 10 + 7);
+    const ir::Automaton& a = c->module.find_automaton("patch32")->automaton;
+    CHECK(a.arcs.size() == 1 + 3 + 2 + 6);
+    CHECK_THAT(test::errors_of("bcifs b { cell v in bary(1); cell e in bary(3); cell f in bary(9); "
+                               "topology e = edge(v) split 2; topology f = quad(e) split 2 x 3; }"),
+               Catch::Contains("quad(e, g) takes a second edge cell"));
+}
