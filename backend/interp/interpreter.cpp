@@ -48,7 +48,8 @@ public:
     // tape copy costs about what looking it up would). It prunes its own sub-boxes in turn, so tapes
     // shrink down the tree.
     std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
-        if (!options_.prune || !has_choices_) return nullptr;
+        if (!options_.prune || !has_choices_ || expected_evaluations <= interp_min_expected_evaluations)
+            return nullptr;
         const auto t0 = std::chrono::steady_clock::now();
         const std::vector<ir::Choice> choices = record(box);
         const auto t1 = std::chrono::steady_clock::now();
