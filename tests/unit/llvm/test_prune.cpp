@@ -5,6 +5,7 @@
 
 #include "backend/interp/interpreter.hpp"
 #include "bench/large_models.hpp"
+#include "driver/engines.hpp"
 #include "ir/specialize.hpp"
 #include "runtime/rss.hpp"
 
@@ -353,4 +354,17 @@ TEST_CASE("a large model's tapes shrink down the tree, and its cover stays the s
     CHECK(pruning->specialize_stats.requests == pruning->specialize_stats.unpruned +
                                                     pruning->specialize_stats.too_little +
                                                     pruning->specialize_stats.pushes);
+}
+
+TEST_CASE("the default engine interprets a large model with choices, and compiles a small one",
+          "[llvm][prune]") {
+    const bench::LargeModel big = bench::large_model(200);
+    const Model m = compile(big.source);
+    const front::ShapeInfo& s = info_of(m, big.name);
+    CHECK(tape_of(m, big.name).instruction_count() > 1000);
+    driver::EngineOptions options; // the default engine: "jit"
+    CHECK(driver::make_evaluator(m.c->module, s.root, s.dimension, options)->engine() == "interp");
+    const Model small = compile(csg_model);
+    const front::ShapeInfo& scene = info_of(small, "scene");
+    CHECK(driver::make_evaluator(small.c->module, scene.root, scene.dimension, options)->engine() == "jit");
 }
