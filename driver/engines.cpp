@@ -3,6 +3,7 @@
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/aot.hpp"
 #include "backend/llvm/jit.hpp"
+#include "ir/specialize.hpp"
 #include "ir/tape.hpp"
 
 #include <fmt/format.h>
@@ -10,12 +11,26 @@
 
 namespace frac::driver {
 
+namespace {
+
+// A tape with min/max to prune and more instructions than this goes to the interpreter even when the
+// JIT is asked for: LLVM's compile grows faster than the tape (5 s for 1,262 instructions, 22-67 s for
+// 3,720-12,033 on the loaded development machine), while the interpreter's tape pushes cover such
+// models at depth 10 in 0.14-0.6 s, as fast per evaluation as the JIT's code on the whole tape
+// (docs/performance.md, "Large models"). The stdlib's shapes and the CSG scene of bench_prune stay
+// far below it.
+constexpr std::size_t jit_max_prunable_instructions = 1000;
+
+} // namespace
+
 std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId root, int inputs,
                                               const EngineOptions& options) {
     ir::Tape tape = ir::build_tape(m.graph, root, inputs);
     if (std::string defect = ir::verify_tape(tape); !defect.empty())
         throw front::InternalError("malformed tape: " + defect);
-    if (options.engine == "jit") {
+    const bool prunable_and_large = options.eval.prune && ir::has_choices(tape) &&
+                                    tape.instruction_count() > jit_max_prunable_instructions;
+    if (options.engine == "jit" && !prunable_and_large) {
         std::string why;
         if (jit::jit_available(&why)) {
             try {
@@ -35,7 +50,7 @@ std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId
         } catch (const jit::JitError& e) {
             throw RunError(fmt::format("the aot engine cannot be used: {}", e.what()));
         }
-    } else if (options.engine != "interp") {
+    } else if (options.engine != "interp" && options.engine != "jit") {
         throw RunError(fmt::format("unknown engine '{}' (available: jit, interp, aot)", options.engine));
     }
     return interp::make_interpreter(std::move(tape), options.eval);

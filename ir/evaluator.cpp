@@ -23,9 +23,11 @@ SpecializeStats& SpecializeStats::operator+=(const SpecializeStats& o) {
     declined += o.declined;
     hits += o.hits;
     compiled += o.compiled;
+    pushes += o.pushes;
     fallbacks += o.fallbacks;
     compile_ms += o.compile_ms;
     record_ms += o.record_ms;
+    prune_ms += o.prune_ms;
     return *this;
 }
 

@@ -40,10 +40,12 @@ struct SpecializeStats {
     std::uint64_t too_little = 0; // ... where pruning saved less than the rule asks
     std::uint64_t declined = 0;   // ... where compiling would cost more than it saves (or the cache is full)
     std::uint64_t hits = 0;       // ... answered by an already compiled specialisation
-    std::uint64_t compiled = 0;   // ... that compiled a new one
+    std::uint64_t compiled = 0;   // ... that compiled a new one (machine code)
+    std::uint64_t pushes = 0;     // ... that made a pruned tape the interpreter runs (no compile)
     std::uint64_t fallbacks = 0;  // ... that made a second-tier (interpreted) one, no compile
-    double compile_ms = 0;        // time spent compiling them
+    double compile_ms = 0;        // time spent compiling them (machine code; 0 for the interpreter)
     double record_ms = 0;         // time spent recording choices
+    double prune_ms = 0;          // time spent building pruned tapes (ir::specialize, the rule)
 
     SpecializeStats& operator+=(const SpecializeStats& o);
 };

@@ -232,6 +232,9 @@ NodeId Graph::op(Op op, NodeId a, NodeId b, NodeId c, std::int64_t imm) {
         const bool holds = op == Op::Le || op == Op::Ge || op == Op::Eq;
         return constant(holds ? tv_true : tv_false, holds ? 1.0 : 0.0);
     }
+    // A product of a value with itself is its square: [0, ...] where the factor straddles 0, where a
+    // product of independent factors would be [-a*b, ...]. Exported models write squares this way.
+    if (op == Op::Mul && a == b) return this->op(Op::Sqr, a);
     // A select on a decided condition is its branch.
     if (op == Op::Select && is_const(a)) {
         const Interval cond = nodes_[a].value;

@@ -2,12 +2,13 @@
 
 #include "ir/semantics.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
-#include <unordered_set>
 
 namespace frac::ir {
 
@@ -40,7 +41,8 @@ bool contains_zero(Interval v) {
 // are not, so there only the operations that produce them count.
 class EmptinessAnalysis {
 public:
-    EmptinessAnalysis(const Tape& t, const Interval* slots) : t_(t), v_(slots), f_(t.num_slots) {
+    EmptinessAnalysis(const Tape& t, const Interval* slots) : t_(t), v_(slots), f_(scratch()) {
+        f_.assign(t.num_slots, SlotFacts{});
         for (const TapeConst& c : t.constants)
             f_[c.slot] = {false, c.value.lo >= 0, c.value.lo >= 0 && c.value.hi > 0};
         for (Slot s : t.input_slots)
@@ -135,9 +137,15 @@ private:
         if (known && v_[out].is_empty()) f_[out].may_empty = true;
     }
 
+    // Reused by the thread's analyses (one per tape push: allocations would cost as much as the work).
+    static std::vector<SlotFacts>& scratch() {
+        thread_local std::vector<SlotFacts> facts;
+        return facts;
+    }
+
     const Tape& t_;
     const Interval* v_;
-    std::vector<SlotFacts> f_;
+    std::vector<SlotFacts>& f_;
 };
 
 bool usable(Interval v) {
@@ -201,12 +209,31 @@ bool any_decided(const std::vector<Choice>& choices) {
 
 namespace {
 
+// The cost (tape_cost) of the instructions of block b, and of the series blocks it runs, that `keep`.
+template <class Keep>
+double cost_of(const Tape& t, std::uint32_t b, const Keep& keep) {
+    double c = 0;
+    for (const Instr& ins : t.blocks[b]) {
+        if (!keep(ins)) continue;
+        c += 1;
+        // An external function (a branch and bound over an automaton) costs far more than an operation:
+        // pruning it away is worth a compilation sooner.
+        if (ins.op == Op::External) c += 100;
+        if (is_series(ins.op)) c += series_terms_estimate * cost_of(t, t.series[ins.series].block, keep);
+    }
+    return c;
+}
+
 // Builds the pruned tape: slot aliases for the decided choices, liveness from the result, then a
 // copy of the live code with slots numbered in program order.
 class Pruner {
 public:
     Pruner(const Tape& t, const std::vector<Choice>& choices)
-        : t_(t), alias_(t.num_slots), def_(t.num_slots) {
+        : t_(t), alias_(scratch().alias), def_(scratch().def), used_(scratch().used),
+          renumber_(scratch().renumber) {
+        alias_.resize(t.num_slots);
+        def_.assign(t.num_slots, nullptr);
+        used_.assign(t.num_slots, 0);
         for (Slot s = 0; s < t.num_slots; ++s) alias_[s] = s;
         for (std::size_t k = 0; k < t.blocks[0].size(); ++k) {
             const Instr& ins = t.blocks[0][k];
@@ -218,8 +245,13 @@ public:
             for (const Instr& ins : blk) def_[ins.out] = &ins;
     }
 
-    Tape run() {
+    Tape run(double max_cost) {
         mark(map(t_.result));
+        if (max_cost < std::numeric_limits<double>::infinity() && cost_of(t_, 0, [this](const Instr& ins) {
+                                                                      return live_slot(ins.out) &&
+                                                                             alias_[ins.out] == ins.out;
+                                                                  }) > max_cost)
+            return {};
         Tape out;
         out.inputs = t_.inputs;
         out.externals = t_.externals;
@@ -239,7 +271,7 @@ public:
 private:
     Slot map(Slot s) const { return s == no_slot ? no_slot : alias_[s]; }
 
-    bool live_slot(Slot s) const { return used_.count(s) != 0; }
+    bool live_slot(Slot s) const { return used_[s] != 0; }
 
     // Marks `s` needed, and with it the code computing it (an explicit stack: tapes can be deep).
     void mark(Slot root) {
@@ -247,7 +279,8 @@ private:
         while (!todo.empty()) {
             const Slot s = todo.back();
             todo.pop_back();
-            if (s == no_slot || !used_.insert(s).second) continue;
+            if (s == no_slot || used_[s]) continue;
+            used_[s] = 1;
             const Instr* ins = def_[s];
             if (!ins) continue; // a constant, an input, a series index or orbit state
             if (!is_series(ins->op)) {
@@ -309,19 +342,31 @@ private:
         return static_cast<std::uint32_t>(out.series.size() - 1);
     }
 
+    // Reused by the thread's pruners (one per tape push: allocations would cost as much as the work).
+    struct Scratch {
+        std::vector<Slot> alias;
+        std::vector<const Instr*> def;
+        std::vector<char> used;
+        std::vector<Slot> renumber;
+    };
+    static Scratch& scratch() {
+        thread_local Scratch s;
+        return s;
+    }
+
     const Tape& t_;
-    std::vector<Slot> alias_;
-    std::vector<const Instr*> def_;
-    std::unordered_set<Slot> used_;
-    std::vector<Slot> renumber_;
+    std::vector<Slot>& alias_;
+    std::vector<const Instr*>& def_;
+    std::vector<char>& used_; // by slot: needed for the result
+    std::vector<Slot>& renumber_;
 };
 
 } // namespace
 
-Tape specialize(const Tape& tape, const std::vector<Choice>& choices) {
+Tape specialize(const Tape& tape, const std::vector<Choice>& choices, double max_cost) {
     if (tape.blocks.empty() || choices.size() != tape.blocks[0].size())
         throw std::invalid_argument("specialize: one choice per instruction of block 0 is needed");
-    return Pruner(tape, choices).run();
+    return Pruner(tape, choices).run(max_cost);
 }
 
 namespace {
@@ -385,24 +430,13 @@ std::string tape_key(const Tape& t) {
     return s;
 }
 
-namespace {
-
-double block_cost(const Tape& t, std::uint32_t b) {
-    double c = 0;
-    for (const Instr& ins : t.blocks[b]) {
-        c += 1;
-        // An external function (a branch and bound over an automaton) costs far more than an operation:
-        // pruning it away is worth a compilation sooner.
-        if (ins.op == Op::External) c += 100;
-        if (is_series(ins.op)) c += series_terms_estimate * block_cost(t, t.series[ins.series].block);
-    }
-    return c;
+double tape_cost(const Tape& tape) {
+    return tape.blocks.empty() ? 0 : cost_of(tape, 0, [](const Instr&) { return true; });
 }
 
-} // namespace
-
-double tape_cost(const Tape& tape) {
-    return tape.blocks.empty() ? 0 : block_cost(tape, 0);
+double push_max_cost(double cost_current, double expected_evaluations) {
+    return std::nextafter(cost_current, 0.0) -
+           push_build_evaluations * cost_current / std::max(expected_evaluations, 1e-300);
 }
 
 std::size_t SpecializationCache::size() const {
@@ -416,13 +450,16 @@ std::shared_ptr<Evaluator> SpecializationCache::get(const Tape& current, const s
         ++stats.unpruned;
         return nullptr;
     }
+    const auto t0 = std::chrono::steady_clock::now();
     Tape pruned = specialize(current, choices);
     const double before = tape_cost(current), after = tape_cost(pruned);
-    if (after > max_cost_ratio * before) {
+    std::string key = after > max_cost_ratio * before ? std::string() : tape_key(pruned);
+    stats.prune_ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (key.empty()) {
         ++stats.too_little;
         return nullptr;
     }
-    std::string key = tape_key(pruned);
     std::lock_guard<std::mutex> lock(mu_);
     auto found = entries_.find(key);
     if (found == entries_.end()) {
@@ -442,10 +479,10 @@ std::shared_ptr<Evaluator> SpecializationCache::get(const Tape& current, const s
     const double compile_ns = costs_.compile_ns_fixed + costs_.compile_ns_per_instruction *
                                                             static_cast<double>(pruned.instruction_count());
     if (saved_ns >= compile_ns) {
-        const auto t0 = std::chrono::steady_clock::now();
+        const auto t1 = std::chrono::steady_clock::now();
         entry.compiled = compile_(pruned);
         stats.compile_ms +=
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
         ++stats.compiled;
         ++compiled_count_;
         entry.fallback.reset();

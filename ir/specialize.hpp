@@ -20,6 +20,7 @@
 #include "ir/tape.hpp"
 
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -47,9 +48,11 @@ bool any_decided(const std::vector<Choice>& choices);
 
 // The tape with each decided choice of block 0 replaced by the operand it takes, the code no longer
 // needed removed (series included) and the slots renumbered densely in program order, so two ways
-// of pruning to the same function give the same tape. Throws std::invalid_argument on a choices
-// vector of the wrong size.
-Tape specialize(const Tape& tape, const std::vector<Choice>& choices);
+// of pruning to the same function give the same tape. When that tape would cost (tape_cost) more
+// than `max_cost`, returns an empty tape (no blocks) without copying the code. Throws
+// std::invalid_argument on a choices vector of the wrong size.
+Tape specialize(const Tape& tape, const std::vector<Choice>& choices,
+                double max_cost = std::numeric_limits<double>::infinity());
 
 // A byte string identifying a tape exactly (the cache key of compiled specialisations).
 std::string tape_key(const Tape& tape);
@@ -78,6 +81,15 @@ struct PruneCosts {
 // it when that evaluates the pruned tape faster than the engine evaluates the current one:
 //   fallback_ns_per_cost * cost(pruned) < eval_ns_per_cost * cost(current).
 inline constexpr double max_cost_ratio = 0.9;
+// The rule of an engine that runs a pruned tape without compiling it (the interpreter, and the
+// JIT's second tier): a tape push pays when the expected evaluations of the sub-boxes save more than
+// building the pruned tape costs, about `push_build_evaluations` evaluations of the current tape
+// (bench/bench_large.cpp measures it):
+//   expected_evaluations * (cost(current) - cost(pruned)) >= push_build_evaluations * cost(current),
+// and cost(pruned) < cost(current): the most a pruned tape may cost is push_max_cost.
+inline constexpr double push_build_evaluations = 2;
+double push_max_cost(double cost_current, double expected_evaluations);
+
 // Compiled specialisations one evaluator family keeps; past it, new ones are declined.
 inline constexpr std::size_t max_specializations = 512;
 

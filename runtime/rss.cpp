@@ -77,6 +77,14 @@ void validate(const ir::Evaluator& f, const std::vector<Interval>& root, const R
         throw std::invalid_argument("subdivide: threads must be in [0, 1024]");
 }
 
+// A function cells evaluate (Runner::variants_): the shape's or a pruned one, with an evaluator per thread.
+struct Variant {
+    std::shared_ptr<ir::Evaluator> function;
+    std::vector<std::unique_ptr<ir::Evaluator>> owned;
+    std::vector<ir::Evaluator*> workers; // one per thread
+    double instructions = 0;             // of its function
+};
+
 // One run of the subdivision. Holds the frontier of the current level (its undecided cells) and
 // the batch being filled, nothing else unless keep_cells.
 class Runner {
@@ -93,26 +101,20 @@ public:
         variants_.emplace_back();
         variants_[0].workers.push_back(&f_);
         for (const auto& c : clones_) variants_[0].workers.push_back(c.get());
+        variants_[0].instructions = static_cast<double>(f_.instruction_count());
         // Each thread gets a batch of its own per flush.
         flush_at_ = r_.options.batch * static_cast<std::size_t>(threads_);
         queue_.reserve(std::min<std::size_t>(flush_at_, 1 << 16));
     }
 
     ~Runner() {
-        // The clones' work counts as the caller's evaluator's.
-        for (const Variant& v : variants_)
-            for (ir::Evaluator* w : v.workers) {
-                if (w == &f_) continue;
-                f_.stats.calls += w->stats.calls;
-                f_.stats.series_terms += w->stats.series_terms;
-                f_.stats.series_capped += w->stats.series_capped;
-                f_.specialize_stats += w->specialize_stats;
-            }
+        for (const Variant& v : variants_) count_work(v);
     }
 
     void run() {
         const int depth = r_.depth;
         r_.levels.assign(static_cast<std::size_t>(depth) + 1, LevelCounts{});
+        r_.prune_levels.assign(static_cast<std::size_t>(depth) + 1, PruneLevel{});
         last_progress_ = Clock::now();
 
         start_level(0);
@@ -122,6 +124,7 @@ public:
             check_budget(k, next_.size());
             std::vector<Pos> parents;
             parents.swap(next_);
+            release_unused(parents);
             start_level(k);
             push_children(parents);
             finish_level();
@@ -132,7 +135,7 @@ public:
         }
         r_.boundary = r_.levels[static_cast<std::size_t>(depth)].undecided;
         r_.subdivided = r_.evaluated - r_.inside - r_.outside - r_.boundary;
-        r_.specializations = variants_.size() - 1;
+        r_.specializations = created_;
     }
 
 private:
@@ -249,7 +252,7 @@ private:
 
         const bool last = level_ == r_.depth;
         const int remaining = r_.depth - level_;
-        const bool consider_pruning = remaining >= prune_min_remaining && level_ % prune_period == 0;
+        const bool consider_pruning = remaining >= std::max(1, r_.options.prune_min_remaining);
         LevelCounts& lc = r_.levels[static_cast<std::size_t>(level_)];
         for (std::size_t j = 0; j < m; ++j) {
             CellClass cls = CellClass::boundary;
@@ -295,21 +298,26 @@ private:
         for (std::size_t j = 0; j < m && !mixed; ++j) mixed = queue_[j].variant != queue_[0].variant;
         const Interval* boxes = boxes_.data();
         Interval* out = out_.data();
-        order_.clear();
         std::vector<std::size_t> starts{0}; // of each variant's run in the gathered order
         std::vector<std::uint32_t> run_variant;
         if (!mixed) {
             run_variant.push_back(queue_[0].variant);
             starts.push_back(m);
         } else {
-            std::vector<std::vector<std::size_t>> members(variants_.size());
-            for (std::size_t j = 0; j < m; ++j) members[queue_[j].variant].push_back(j);
-            for (std::uint32_t v = 0; v < members.size(); ++v) {
-                if (members[v].empty()) continue;
-                order_.insert(order_.end(), members[v].begin(), members[v].end());
+            // A counting sort by variant: linear in the cells and the variants.
+            offset_.assign(variants_.size() + 1, 0);
+            for (std::size_t j = 0; j < m; ++j) ++offset_[queue_[j].variant + 1];
+            for (std::uint32_t v = 0; v < variants_.size(); ++v) {
+                if (offset_[v + 1] == 0) {
+                    offset_[v + 1] = offset_[v];
+                    continue;
+                }
                 run_variant.push_back(v);
-                starts.push_back(order_.size());
+                offset_[v + 1] += offset_[v];
+                starts.push_back(offset_[v + 1]);
             }
+            order_.resize(m);
+            for (std::size_t j = 0; j < m; ++j) order_[offset_[queue_[j].variant]++] = j;
             group_boxes_.resize(m * d);
             group_out_.resize(m);
             for (std::size_t i = 0; i < m; ++i) std::copy_n(&boxes_[order_[i] * d], d, &group_boxes_[i * d]);
@@ -323,7 +331,12 @@ private:
         std::vector<Chunk> chunks;
         for (std::size_t r = 0; r < run_variant.size(); ++r) {
             const std::size_t n = starts[r + 1] - starts[r];
-            if (run_variant[r] != 0) r_.pruned_evaluations += n;
+            PruneLevel& pl = r_.prune_levels[static_cast<std::size_t>(level_)];
+            if (run_variant[r] != 0) {
+                r_.pruned_evaluations += n;
+                pl.pruned_evaluations += n;
+            }
+            pl.instructions += static_cast<double>(n) * variants_[run_variant[r]].instructions;
             const auto k = std::max<std::size_t>(
                 1, std::min<std::size_t>(
                        threads_ == 1 ? 1 : chunks_per_thread * static_cast<std::size_t>(threads_),
@@ -369,19 +382,66 @@ private:
     // function when the evaluator offers one (the same function always maps to the same variant).
     std::uint32_t pruned_variant(std::uint32_t v, const Interval* box) {
         ir::Evaluator& e = *variants_[v].workers[0];
+        PruneLevel& pl = r_.prune_levels[static_cast<std::size_t>(level_)];
+        ++pl.requests;
         std::shared_ptr<ir::Evaluator> p = e.specialize(box, expected_descendants(r_.depth - level_));
         if (!p) return v;
+        ++pl.pruned;
         auto [it, added] = variant_of_.try_emplace(p.get(), static_cast<std::uint32_t>(variants_.size()));
         if (added) {
             Variant nv;
-            nv.function = p;
+            nv.instructions = static_cast<double>(p->instruction_count());
+            // An evaluator made for this cell alone (no cache holds it) serves the first thread itself.
+            const bool own = p.use_count() == 1;
             for (int t = 0; t < threads_; ++t) {
+                if (t == 0 && own) {
+                    nv.workers.push_back(p.get());
+                    continue;
+                }
                 nv.owned.push_back(p->clone());
                 nv.workers.push_back(nv.owned.back().get());
             }
+            nv.function = std::move(p);
             variants_.push_back(std::move(nv));
+            ++created_;
         }
         return it->second;
+    }
+
+    // The work of a variant's evaluators counts as the caller's evaluator's.
+    void count_work(const Variant& v) {
+        for (ir::Evaluator* w : v.workers) {
+            if (w == &f_) continue;
+            f_.stats.calls += w->stats.calls;
+            f_.stats.series_terms += w->stats.series_terms;
+            f_.stats.series_capped += w->stats.series_capped;
+            f_.specialize_stats += w->specialize_stats;
+            w->stats = {};
+            w->specialize_stats = {};
+        }
+    }
+
+    // Frees the variants no cell of `frontier` evaluates any more (pruning makes one per pruned
+    // cell), numbering the others densely in their old order (so the output does not change).
+    void release_unused(std::vector<Pos>& frontier) {
+        if (variants_.size() == 1) return;
+        std::vector<std::uint32_t> renumber(variants_.size(), 0);
+        for (const Pos& p : frontier) renumber[p.variant] = 1;
+        renumber[0] = 1;
+        std::uint32_t kept = 0;
+        for (std::uint32_t v = 0; v < variants_.size(); ++v) {
+            if (!renumber[v]) {
+                count_work(variants_[v]);
+                continue;
+            }
+            renumber[v] = kept;
+            if (kept != v) variants_[kept] = std::move(variants_[v]);
+            ++kept;
+        }
+        variants_.resize(kept);
+        variant_of_.clear();
+        for (std::uint32_t v = 1; v < kept; ++v) variant_of_.emplace(variants_[v].function.get(), v);
+        for (Pos& p : frontier) p.variant = renumber[p.variant];
     }
 
     static constexpr std::size_t min_chunk = 256;              // below this a thread costs more than it saves
@@ -395,15 +455,12 @@ private:
     std::vector<std::unique_ptr<ir::Evaluator>> clones_;
     // The functions cells evaluate: 0 is the shape's (f_ and its clones), the others pruned ones,
     // each with an evaluator per thread.
-    struct Variant {
-        std::shared_ptr<ir::Evaluator> function;
-        std::vector<std::unique_ptr<ir::Evaluator>> owned;
-        std::vector<ir::Evaluator*> workers; // one per thread
-    };
     std::vector<Variant> variants_;
     std::unordered_map<const ir::Evaluator*, std::uint32_t> variant_of_;
     std::vector<Interval> group_boxes_, group_out_; // cells gathered by variant
     std::vector<std::size_t> order_;                // ... their positions in the batch
+    std::vector<std::size_t> offset_;               // ... and where each variant's run starts
+    std::size_t created_ = 0;                       // pruned functions made (variants after the first)
     std::size_t flush_at_ = 0;
     int level_ = 0;
     std::uint64_t n_ = 1;                     // cells per axis at level_

@@ -34,6 +34,14 @@ namespace frac::rt {
 // of cells evaluated so far over all levels.
 using RssProgress = std::function<void(int level, std::uint64_t evaluated)>;
 
+// Min/max pruning (ir/specialize.hpp, switched by EvalOptions::prune): an undecided cell at least
+// RssOptions::prune_min_remaining levels above the depth limit asks its evaluator for a simplified
+// function, which its descendants then evaluate, and which they simplify further in turn (the tapes
+// shrink down the tree). The evaluator's rule says whether it pays for the expected descendants. The
+// cover is the same with and without it (docs/design.md, "Pruning"). The default, 1 (every level
+// with children), measured on bench/bench_large.cpp and bench/csg_scene.frac (docs/performance.md).
+inline constexpr int default_prune_min_remaining = 1;
+
 struct RssOptions {
     int depth = 8;            // levels of subdivision below the root box
     int split = 2;            // parts per axis and level
@@ -51,26 +59,26 @@ struct RssOptions {
     // a level that would pass it, and as soon as the growth of the last level foretells that the depth
     // would pass it (a LimitError, with the estimate).
     std::uint64_t max_cells = 0;
+    // Levels above the depth limit (at least) where undecided cells ask for a pruned function.
+    int prune_min_remaining = default_prune_min_remaining;
 };
 
 // The default of the command line's --max-cells: 2^27 cells, about 2 GB kept (16 bytes a cell, and the
 // frontier of undecided cells beside them) and a few seconds to a minute of evaluation.
 inline constexpr std::uint64_t default_max_cells = std::uint64_t{1} << 27;
 
-// Min/max pruning (ir/specialize.hpp, switched by EvalOptions::prune): an undecided cell far enough
-// above the depth limit asks its evaluator for a simplified function, which its descendants then
-// evaluate. The cover is the same with and without it (docs/design.md, "Pruning").
-// Pruning is considered for undecided cells at levels k with depth - k >= prune_min_remaining and
-// k a multiple of prune_period. Closer to the depth too few descendants are left to repay recording
-// the choices (one interpreter evaluation of the cell); measured on bench/csg_scene.frac with both
-// engines (docs/performance.md).
-inline constexpr int prune_min_remaining = 5;
-inline constexpr int prune_period = 1;
-
 // Hard limits, reported as errors when exceeded. Besides, split^depth must not exceed 2^32 (cell
 // positions are 32-bit): with split 3 the depth is at most 20, with split 4 at most 16.
 inline constexpr int max_depth_2d = 24;
 inline constexpr int max_depth_3d = 14;
+
+// What pruning did on one level.
+struct PruneLevel {
+    std::uint64_t requests = 0;           // undecided cells that asked their evaluator for a pruned function
+    std::uint64_t pruned = 0;             // ... and got one, for their children
+    std::uint64_t pruned_evaluations = 0; // cells of the level evaluated with a pruned function
+    double instructions = 0;              // instructions of the functions evaluated, summed over the cells
+};
 
 // A subdivision's cover (depth and split from its options) with what the run measured.
 struct RssResult : Cover {
@@ -79,6 +87,7 @@ struct RssResult : Cover {
     // Pruning: cells evaluated with a simplified function, and how many distinct functions they used.
     std::uint64_t pruned_evaluations = 0;
     std::size_t specializations = 0;
+    std::vector<PruneLevel> prune_levels; // index = level, 0..depth
 };
 
 // Throws std::invalid_argument on a bad depth/split/batch or a box of the wrong dimension (the

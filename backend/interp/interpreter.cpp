@@ -20,21 +20,18 @@ namespace {
 
 class Interpreter final : public ir::Evaluator {
 public:
-    Interpreter(Tape tape, const ir::EvalOptions& options, std::weak_ptr<ir::SpecializationCache> cache = {})
-        : tape_(std::move(tape)), options_(options), cache_(std::move(cache)), boxes_(tape_.num_slots),
-          points_(tape_.num_slots) {
+    Interpreter(Tape tape, const ir::EvalOptions& options)
+        : tape_(std::move(tape)), options_(options), has_choices_(ir::has_choices(tape_)),
+          cost_(ir::tape_cost(tape_)), boxes_(tape_.num_slots) {
         if (options_.max_terms < 1 || options_.max_terms > ir::max_terms_limit)
             throw std::invalid_argument("max_terms out of range");
-        for (const ir::TapeConst& c : tape_.constants) {
-            boxes_[c.slot] = c.value;
-            points_[c.slot] = c.point;
-        }
+        for (const ir::TapeConst& c : tape_.constants) boxes_[c.slot] = c.value;
     }
 
     int dimension() const override { return tape_.inputs; }
     std::string engine() const override { return "interp"; }
     std::unique_ptr<ir::Evaluator> clone() const override {
-        return std::make_unique<Interpreter>(tape_, options_, cache_);
+        return std::make_unique<Interpreter>(tape_, options_);
     }
     std::size_t instruction_count() const override { return tape_.instruction_count(); }
 
@@ -47,25 +44,39 @@ public:
         return ir::record_choices(tape_, boxes_.data());
     }
 
+    // A tape push: the pruned tape of the box, made for this cell's descendants alone (no cache: a
+    // tape copy costs about what looking it up would). It prunes its own sub-boxes in turn, so tapes
+    // shrink down the tree.
     std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
-        auto cache = cache_.lock();
-        if (!cache || !options_.prune || !ir::has_choices(tape_)) return nullptr;
+        if (!options_.prune || !has_choices_ || expected_evaluations <= interp_min_expected_evaluations)
+            return nullptr;
         const auto t0 = std::chrono::steady_clock::now();
         const std::vector<ir::Choice> choices = record(box);
-        specialize_stats.record_ms +=
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        const auto t1 = std::chrono::steady_clock::now();
+        specialize_stats.record_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();
         ++specialize_stats.requests;
-        return cache->get(tape_, choices, expected_evaluations, specialize_stats);
-    }
-
-    // The root of an evaluator family owns the cache; its specialisations refer to it weakly (the
-    // cache owns them).
-    void own_cache(std::shared_ptr<ir::SpecializationCache> cache) {
-        cache_ = cache;
-        owned_cache_ = std::move(cache);
+        if (!ir::any_decided(choices)) {
+            ++specialize_stats.unpruned;
+            return nullptr;
+        }
+        ir::Tape pruned = ir::specialize(tape_, choices, ir::push_max_cost(cost_, expected_evaluations));
+        std::shared_ptr<ir::Evaluator> result;
+        if (!pruned.blocks.empty()) {
+            result = std::make_shared<Interpreter>(std::move(pruned), options_);
+            ++specialize_stats.pushes;
+        } else {
+            ++specialize_stats.too_little;
+        }
+        specialize_stats.prune_ms +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
+        return result;
     }
 
     double eval_point(const double* coords) override {
+        if (points_.empty() && tape_.num_slots > 0) { // made on first use: pruned tapes serve boxes only
+            points_.resize(tape_.num_slots);
+            for (const ir::TapeConst& c : tape_.constants) points_[c.slot] = c.point;
+        }
         ++stats.calls;
         load(points_, coords);
         run_points(0);
@@ -297,8 +308,8 @@ private:
 
     Tape tape_;
     ir::EvalOptions options_;
-    std::weak_ptr<ir::SpecializationCache> cache_;
-    std::shared_ptr<ir::SpecializationCache> owned_cache_;
+    bool has_choices_; // block 0 has something to prune
+    double cost_;      // ir::tape_cost of the tape
     std::vector<Interval> boxes_;
     std::vector<double> points_;
 };
@@ -306,17 +317,7 @@ private:
 } // namespace
 
 std::unique_ptr<ir::Evaluator> make_interpreter(ir::Tape tape, const ir::EvalOptions& options) {
-    auto root = std::make_unique<Interpreter>(std::move(tape), options);
-    // The specialisations it compiles refer to the cache weakly (the cache owns them).
-    auto self = std::make_shared<std::weak_ptr<ir::SpecializationCache>>();
-    auto cache = std::make_shared<ir::SpecializationCache>(
-        [options, self](const Tape& t) -> std::unique_ptr<ir::Evaluator> {
-            return std::make_unique<Interpreter>(t, options, *self);
-        },
-        interp_prune_costs);
-    *self = cache;
-    root->own_cache(cache);
-    return root;
+    return std::make_unique<Interpreter>(std::move(tape), options);
 }
 
 ChoiceRecorder::ChoiceRecorder(const ir::Tape& tape, const ir::EvalOptions& options)

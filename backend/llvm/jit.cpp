@@ -210,7 +210,9 @@ public:
     // interpreter's enclosures are the JIT's bit for bit, so both engines prune alike.
     std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
         auto cache = cache_.lock();
-        if (!cache || !code_->options.prune || !code_->has_choices) return nullptr;
+        if (!cache || !code_->options.prune || !code_->has_choices ||
+            expected_evaluations < jit_min_expected_evaluations)
+            return nullptr;
         const auto t0 = Clock::now();
         if (!recorder_) recorder_ = std::make_unique<interp::ChoiceRecorder>(code_->tape, code_->options);
         const std::vector<ir::Choice> choices = recorder_->record(box);

@@ -57,6 +57,12 @@ std::unique_ptr<ir::Evaluator> make_jit(const ir::Tape& tape, const ir::EvalOpti
 inline constexpr ir::PruneCosts jit_prune_costs{/*eval_ns_per_cost=*/0.8, /*compile_ns_fixed=*/2.0e7,
                                                 /*compile_ns_per_instruction=*/2.0e6};
 
+// Recording the choices over a box is an interpreter evaluation of the whole tape, 10-30 JIT
+// evaluations: the JIT records only for a cell with at least this many expected descendant
+// evaluations (in 2D, 5 levels above the depth; measured in docs/performance.md, "Min/max pruning").
+// Its second tier (pruned tapes on the interpreter) records at every level.
+inline constexpr double jit_min_expected_evaluations = 120;
+
 // What compiling one tape cost (wall clock, milliseconds), for benchmarks and --verbose output.
 struct CompileInfo {
     double tables_ms = 0;            // index and series tables

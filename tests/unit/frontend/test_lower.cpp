@@ -13,10 +13,14 @@ TEST_CASE("functions and lets are inlined into one hash-consed graph", "[lower]"
     const ShapeInfo* s = c->module.find_shape("s");
     REQUIRE(s);
     const ir::Tape t = ir::build_tape(c->module.graph, s->root, 2);
-    // x*x appears once although it is written three times.
-    int muls = 0;
-    for (const auto& ins : t.blocks[0]) muls += ins.op == ir::Op::Mul;
-    CHECK(muls == 2);
+    // x*x appears once although it is written three times (a square: a product of a node with itself).
+    int squares = 0, muls = 0;
+    for (const auto& ins : t.blocks[0]) {
+        squares += ins.op == ir::Op::Sqr;
+        muls += ins.op == ir::Op::Mul;
+    }
+    CHECK(squares == 2);
+    CHECK(muls == 0);
     CHECK(ir::verify_tape(t).empty());
 }
 
@@ -70,7 +74,10 @@ TEST_CASE("series that cannot be bounded are compile errors that say why", "[ser
           std::string::npos);
     CHECK(errors_of("shape s(x, y) = sum(i in 0.., 2^i);").find("do not decay geometrically") !=
           std::string::npos);
-    CHECK(errors_of("shape s(x, y) = sum(i in 0.., i * i / 2^i);").find("faster than linearly") !=
+    CHECK(errors_of("shape s(x, y) = sum(i in 0.., i * (i + x) / 2^i);").find("faster than linearly") !=
+          std::string::npos);
+    // i * i is a square (the graph makes it one): bounded below, not above.
+    CHECK(errors_of("shape s(x, y) = sum(i in 0.., i * i / 2^i);").find("the argument of sqr grows") !=
           std::string::npos);
     CHECK(errors_of("shape s(x, y) = sum(i in 0.., x^i);").find("positive constant base") !=
           std::string::npos);

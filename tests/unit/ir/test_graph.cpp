@@ -1,4 +1,5 @@
 #include "ir/graph.hpp"
+#include "ir/semantics.hpp"
 #include "ir/tape.hpp"
 
 #include <cmath>
@@ -108,4 +109,22 @@ TEST_CASE("an external call is never folded, and tapes carry the bound implement
     // An index outside the table is a malformed graph.
     g.external(1, g.var(0), g.var(1), zero);
     CHECK(verify_graph(g).find("external #1 out of range") != std::string::npos);
+}
+
+TEST_CASE("a product of a value with itself is its square", "[graph]") {
+    Graph g;
+    const NodeId x = g.var(0);
+    const NodeId u = g.op(Op::Sub, x, g.constant(1.0));
+    const NodeId uu = g.op(Op::Mul, u, u);
+    CHECK(g[uu].op == Op::Sqr);
+    CHECK(uu == g.op(Op::Sqr, u)); // one node, however it is written
+    CHECK(g[g.op(Op::Mul, u, x)].op == Op::Mul);
+    // Over u in [-1, 2] the square is [0, 4]; a product of independent factors would be [-2, 4].
+    const Interval u_box[2] = {{-1, 2}, {-1, 2}};
+    frac::num::UpwardRounding up;
+    CHECK(apply_interval(g[uu].op, u_box, 0) == Interval(0, 4));
+    CHECK(apply_interval(Op::Mul, u_box, 0) == Interval(-2, 4));
+    const Tape t = build_tape(g, g.op(Op::Add, uu, g.constant(0.5)), 1);
+    REQUIRE(t.instruction_count() == 3); // sub, sqr, add
+    CHECK(t.blocks[0][1].op == Op::Sqr);
 }

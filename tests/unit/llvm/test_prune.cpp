@@ -4,6 +4,8 @@
 #include "engines.hpp"
 
 #include "backend/interp/interpreter.hpp"
+#include "bench/large_models.hpp"
+#include "driver/engines.hpp"
 #include "ir/specialize.hpp"
 #include "runtime/rss.hpp"
 
@@ -133,14 +135,20 @@ TEST_CASE("both engines specialise alike and compile each pruned tape once", "[l
     CHECK(sj->instruction_count() == si->instruction_count());
     CHECK(sj->instruction_count() < tape.instruction_count());
     CHECK(jt->specialize_stats.compiled == 1);
-    CHECK(in->specialize_stats.compiled == 1);
+    CHECK(in->specialize_stats.pushes == 1); // the interpreter runs the pruned tape as it is
+    CHECK(in->specialize_stats.compiled == 0);
     // Asked again, from a clone: the same evaluator, from the cache.
     auto clone = jt->clone();
     auto again = clone->specialize(box.data(), 1e12);
     CHECK(again == sj);
     CHECK(clone->specialize_stats.hits == 1);
     CHECK(clone->specialize_stats.compiled == 0);
-    CHECK(in->specialize(box.data(), 1) == si); // compiled already: used whatever the demand
+    CHECK(jt->specialize(box.data(), 1e3) == sj); // compiled already: used whatever the demand
+    // The interpreter makes a tape for each cell that asks, when its descendants repay it: not for one.
+    const auto asked = in->specialize_stats.requests;
+    CHECK_FALSE(in->specialize(box.data(), 1));
+    CHECK(in->specialize_stats.requests == asked); // not even recorded
+    CHECK_FALSE(in->specialize(box.data(), interp::interp_min_expected_evaluations));
     // The specialisation is exact on sub-boxes, with both engines.
     for (const auto& b : {box, inner}) {
         const Interval full = in->eval_box(b.data());
@@ -159,7 +167,10 @@ TEST_CASE("the JIT declines to compile a pruned tape that would not repay it", "
     // The carpet's corner: the carpet's series stays, the rest goes; one evaluation does not pay
     // for a compile, and the interpreter is slower on the carpet's series than the JIT on the scene.
     const std::vector<Interval> box{{0.1, 0.2}, {0.1, 0.2}};
+    // Too few descendants to repay recording the choices: not even asked.
     CHECK_FALSE(jt->specialize(box.data(), 1));
+    CHECK(jt->specialize_stats.requests == 0);
+    CHECK_FALSE(jt->specialize(box.data(), jit::jit_min_expected_evaluations));
     CHECK(jt->specialize_stats.declined == 1);
     CHECK(jt->specialize_stats.compiled == 0);
     // Where only the disk is left, the interpreter runs the small pruned tape when the rule says
@@ -169,7 +180,7 @@ TEST_CASE("the JIT declines to compile a pruned tape that would not repay it", "
     const ir::Tape disk_only = ir::specialize(tape, rec.record(disk_box.data()));
     const bool interp_faster = interp::interp_prune_costs.eval_ns_per_cost * ir::tape_cost(disk_only) <
                                jit::jit_prune_costs.eval_ns_per_cost * ir::tape_cost(tape);
-    auto tier2 = jt->specialize(disk_box.data(), 1);
+    auto tier2 = jt->specialize(disk_box.data(), jit::jit_min_expected_evaluations);
     CHECK(bool(tier2) == interp_faster);
     if (tier2) {
         CHECK(tier2->engine() == "interp");
@@ -278,7 +289,9 @@ TEST_CASE("pruned covers are identical across engines", "[llvm][prune][rss]") {
     CHECK(rt::same_cover(a, b));
     CHECK(a.pruned_evaluations > a.evaluated / 2);
     CHECK(in->specialize_stats.requests > 0);
-    CHECK(jt->specialize_stats.requests == in->specialize_stats.requests);
+    // The JIT records only far enough above the depth (jit_min_expected_evaluations).
+    CHECK(jt->specialize_stats.requests > 0);
+    CHECK(jt->specialize_stats.requests < in->specialize_stats.requests);
     // Which cells evaluate which pruned function does not depend on the thread count.
     auto in2 = InterpEngine::make(tape_of(m, "csg_scene"));
     o.threads = 2;
@@ -306,4 +319,52 @@ TEMPLATE_TEST_CASE("a 3D CSG cover is the same with and without pruning", "[llvm
     CHECK(rt::same_cover(a, b));
     CHECK(pruning->specialize_stats.requests > 0);
     if (std::string(TestType::name) == "interp") CHECK(b.pruned_evaluations > 0);
+}
+
+TEST_CASE("a large model's tapes shrink down the tree, and its cover stays the same", "[llvm][prune][rss]") {
+    // Text strokes, buildings and blends: 600 clauses, thousands of instructions.
+    const bench::LargeModel big = bench::large_model(600);
+    const Model m = compile(big.source);
+    const ir::Tape& tape = tape_of(m, big.name);
+    const front::ShapeInfo& s = info_of(m, big.name);
+    ir::EvalOptions off;
+    off.prune = false;
+    auto plain = InterpEngine::make(tape, off);
+    auto pruning = InterpEngine::make(tape);
+    rt::RssOptions o;
+    o.depth = 8;
+    const rt::RssResult a = rt::subdivide(*plain, s.box, o);
+    const rt::RssResult b = rt::subdivide(*pruning, s.box, o);
+    CHECK(rt::same_cover(a, b));
+    // Every level with children asks to prune, and the functions shrink down the tree (each cell's is
+    // its parent's or a pruned one of it; the mix of cells changes from level to level): at the depth a
+    // cell evaluates a small part of the model.
+    const auto mean = [&](int k) {
+        const auto level = static_cast<std::size_t>(k);
+        return b.prune_levels[level].instructions / static_cast<double>(b.levels[level].evaluated);
+    };
+    for (int k = 0; k < o.depth; ++k) CHECK(b.prune_levels[static_cast<std::size_t>(k)].requests > 0);
+    const double full = static_cast<double>(tape.instruction_count());
+    INFO("instructions per evaluation: " << mean(2) << " at level 2, " << mean(5) << " at 5, "
+                                         << mean(o.depth) << " at the depth, " << full << " unpruned");
+    CHECK(mean(5) < 0.5 * mean(2));
+    CHECK(mean(o.depth) < 0.5 * mean(5));
+    CHECK(mean(o.depth) < 0.02 * full);
+    CHECK(b.prune_levels[static_cast<std::size_t>(o.depth)].requests == 0); // no children to prune for
+    CHECK(pruning->specialize_stats.requests == pruning->specialize_stats.unpruned +
+                                                    pruning->specialize_stats.too_little +
+                                                    pruning->specialize_stats.pushes);
+}
+
+TEST_CASE("the default engine interprets a large model with choices, and compiles a small one",
+          "[llvm][prune]") {
+    const bench::LargeModel big = bench::large_model(200);
+    const Model m = compile(big.source);
+    const front::ShapeInfo& s = info_of(m, big.name);
+    CHECK(tape_of(m, big.name).instruction_count() > 1000);
+    driver::EngineOptions options; // the default engine: "jit"
+    CHECK(driver::make_evaluator(m.c->module, s.root, s.dimension, options)->engine() == "interp");
+    const Model small = compile(csg_model);
+    const front::ShapeInfo& scene = info_of(small, "scene");
+    CHECK(driver::make_evaluator(small.c->module, scene.root, scene.dimension, options)->engine() == "jit");
 }
