@@ -49,10 +49,11 @@ void add_fit_surface_options(CLI::App* fit, FitSurfaceOptions& o) {
 
 namespace {
 
-// A data error as the compiler's diagnostics look: FILE:LINE:COL, the line, a caret (exit 65).
+// A data error as the compiler's diagnostics look: FILE:LINE:COL, the line, a caret; one about the whole
+// file names it (exit 65 both).
 int report_data_error(const rt::fit::DataError& e) {
     if (e.line == 0) {
-        std::cerr << fmt::format("{}: error: {}\n", e.file, e.what());
+        std::cerr << fmt::format("frac: error: {}: {}\n", e.file, e.what());
     } else {
         std::cerr << fmt::format("{}:{}:{}: error: {}\n", e.file, e.line, e.column, e.what());
         std::cerr << fmt::format("{:>5} | {}\n      | {}^\n", e.line, e.source_line,

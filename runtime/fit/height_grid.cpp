@@ -1,10 +1,12 @@
 #include "runtime/fit/height_grid.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <csetjmp>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <memory>
@@ -41,7 +43,7 @@ void check_size(const HeightGrid& g, const std::string& path) {
 
 HeightGrid read_csv_grid(const std::string& path) {
     std::ifstream in(path);
-    if (!in) throw DataError(path, 0, 0, "cannot read the file");
+    if (!in) throw DataError(path, 0, 0, fmt::format("cannot read the file: {}", std::strerror(errno)));
     HeightGrid g;
     std::string text;
     std::size_t line_no = 0;
@@ -142,7 +144,7 @@ const char* colour_name(int type) {
 
 HeightGrid read_png_grid(const std::string& path) {
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
-    if (!file) throw DataError(path, 0, 0, "cannot read the file");
+    if (!file) throw DataError(path, 0, 0, fmt::format("cannot read the file: {}", std::strerror(errno)));
     unsigned char signature[8] = {};
     if (std::fread(signature, 1, 8, file.get()) != 8 || png_sig_cmp(signature, 0, 8) != 0)
         throw DataError(path, 0, 0, "not a PNG file");

@@ -318,7 +318,10 @@ public:
         : options_(options), data_(data), samples_(static_cast<double>(samples)), result_(result),
           start_(std::chrono::steady_clock::now()) {}
     ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
-        const double mse = 2 * summary.cost / samples_;
+        // An unsuccessful step reports the cost it tried; the fit stays at the best so far.
+        if (summary.iteration == 0 || (summary.step_is_successful && summary.cost < best_cost_))
+            best_cost_ = summary.cost;
+        const double mse = 2 * best_cost_ / samples_;
         const double psnr = mse > 0 ? 10.0 * std::log10(data_.peak * data_.peak / mse)
                                     : std::numeric_limits<double>::infinity();
         const double seconds =
@@ -337,6 +340,7 @@ private:
     const HeightGrid& data_;
     double samples_;
     FitResult& result_;
+    double best_cost_ = std::numeric_limits<double>::infinity();
     std::chrono::steady_clock::time_point start_;
 };
 
