@@ -62,6 +62,8 @@ int report_data_error(const rt::fit::DataError& e) {
     return front::exit_compile_error;
 }
 
+constexpr double max_jacobian_bytes = 2e9;
+
 std::size_t parse_patches(const std::string& text) {
     const auto x = text.find('x');
     std::size_t n = 0, m = 0;
@@ -129,6 +131,15 @@ int run_fit_surface(const FitSurfaceOptions& o) {
                 data.width, data.height, data.z.size(), layout->count(), split, split, o.controls,
                 o.controls)));
     const std::size_t side = static_cast<std::size_t>(std::llround(std::pow(split, options.shape.depth))) + 1;
+    // The Jacobian (a row a sample) and the vertices' gradients are dense: refuse what would not fit.
+    const double jacobian_bytes =
+        static_cast<double>(data.z.size() + side * side) * static_cast<double>(layout->count()) * 8.0;
+    if (jacobian_bytes > max_jacobian_bytes)
+        throw UsageError(
+            fmt::format("{} x {} samples and {} x {} vertices of {} parameters would take {:.1f} GB of "
+                        "derivatives (at most {:.1f} GB): downsample the data, or lower --depth",
+                        data.width, data.height, side, side, layout->count(), jacobian_bytes / 1e9,
+                        max_jacobian_bytes / 1e9));
     std::cout << fmt::format("data: {}, {} x {} samples, peak {}\n", o.data, data.width, data.height,
                              data.peak);
     std::cout << fmt::format(
