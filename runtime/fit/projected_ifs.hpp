@@ -109,8 +109,9 @@ struct FitOptions {
     double max_seconds = 0; // 0: no time budget
     double target_psnr = 0; // stop once reached (0: run to convergence or budget)
     Derivatives derivatives = Derivatives::exact;
-    // Bounds of the free weights. Inside [0, 1] the operators stay near stochastic matrices, whose
-    // contraction the compiler can prove; far outside it they need not contract at all.
+    // Bounds of the free weights. Near [0, 1] the operators stay near stochastic matrices, whose
+    // contraction the compiler proves; unbounded, the fit drifts to operators it cannot prove (on the
+    // paraboloid: 40.1 dB unbounded and refused, 38.5 dB within these bounds, 37.4 within [0, 1]).
     double weight_range[2] = {-0.25, 1.25};
     // After each iteration: iteration, PSNR, elapsed seconds.
     std::function<void(int, double, double)> progress;
