@@ -111,7 +111,8 @@ struct FitOptions {
     Derivatives derivatives = Derivatives::exact;
     // Bounds of the free weights. Near [0, 1] the operators stay near stochastic matrices, whose
     // contraction the compiler proves; unbounded, the fit drifts to operators it cannot prove (on the
-    // paraboloid: 40.1 dB unbounded and refused, 38.5 dB within these bounds, 37.4 within [0, 1]).
+    // 28 x 28 paraboloid: 40.1 dB after 20 iterations unbounded, refused; after 60, 38.5 dB within these
+    // bounds, 37.4 within [0, 1]).
     double weight_range[2] = {-0.25, 1.25};
     // After each iteration: iteration, PSNR, elapsed seconds.
     std::function<void(int, double, double)> progress;
