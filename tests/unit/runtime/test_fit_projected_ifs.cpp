@@ -102,6 +102,12 @@ TEST_CASE("fit: Levenberg-Marquardt improves on the start, and quantisation cost
     const double psnr8 = error_stats(data, evaluator.approximation(q8.params)).psnr;
     CHECK(std::abs(psnr16 - fit.stats.psnr) < 0.1);
     CHECK(psnr8 > fit.stats.psnr - 3);
+    // Forward differences (seed 003's way) follow the same path to within their error.
+    FitOptions differences = options;
+    differences.derivatives = Derivatives::finite_differences;
+    differences.max_iterations = 5;
+    options.max_iterations = 5;
+    CHECK(std::abs(fit_patch(data, differences).stats.psnr - fit_patch(data, options).stats.psnr) < 0.5);
     // A target out of reach within the budget is not a converged fit.
     options.target_psnr = 200;
     options.max_iterations = 2;
