@@ -8,6 +8,10 @@
 #include <string>
 #include <vector>
 
+namespace CLI {
+class App;
+}
+
 namespace frac::cli {
 
 // Limits on the cells of a subdivision and the triangles of a mesh (runtime/limits.hpp): --max-cells and
@@ -92,5 +96,15 @@ int render_map(front::Compilation& c, const front::Item& map, const RenderOption
 
 // Runs the print statements (when `prints`) and the tests of each file; prints "N passed, N failed".
 int run_tests(const std::vector<std::string>& files, bool prints, const EngineOptions& engine);
+
+// ---- fit of surfaces and images (cli/fit_surface.cpp) ----
+struct FitSurfaceOptions {
+    std::string data, output, method = "lm", patches = "3x3", name = "fitted";
+    int controls = 4, depth = 0, iterations = 100, bits = 16; // depth 0: chosen from the data's size
+    double seconds = 0, target_psnr = 0;
+};
+void add_fit_surface_options(CLI::App* fit, FitSurfaceOptions& options);
+// frac fit DATA -o MODEL.frac --method lm: a projected IFS fitted to a height grid or a grey image.
+int run_fit_surface(const FitSurfaceOptions& options);
 
 } // namespace frac::cli

@@ -281,6 +281,12 @@ int run(int argc, char** argv) {
         ->capture_default_str();
     add_set(compile);
 
+    cli::FitSurfaceOptions fit_options;
+    auto* fit =
+        app.add_subcommand("fit", "fit a fractal model to data: a projected IFS to a height grid or a "
+                                  "grey image (--method lm)");
+    cli::add_fit_surface_options(fit, fit_options);
+
     // `frac help [COMMAND]`: the text of `frac [COMMAND] --help`.
     std::string help_topic;
     auto* help = app.add_subcommand("help", "print the help of frac or of one command");
@@ -342,6 +348,7 @@ int run(int argc, char** argv) {
         if (*test) return cli::run_tests(files, false, engine);
         if (*compile) return cli::run_compile(file, compile_options);
         if (*run) return cli::run_tests({file}, true, engine);
+        if (*fit) return cli::run_fit_surface(fit_options);
     } catch (const cli::UsageError& e) {
         std::cerr << "frac: error: " << e.what() << "\n";
         return front::exit_usage_error;
