@@ -139,6 +139,10 @@ rt::RssResult cover(const std::vector<ir::Interval>& box, int depth, int split, 
     ro.closed_inside = closed_inside;
     ro.threads = threads;
     ro.depth = depth;
+    if (const auto d = positive_env("FRAC_MAX_DEPTH", "levels")) {
+        if (*d > 32) throw UsageError("FRAC_MAX_DEPTH must be at most 32 (cell positions are 32-bit)");
+        ro.max_depth = static_cast<int>(std::ceil(*d));
+    }
     ro.split = split;
     ro.keep_cells = keep_cells;
     auto printed = std::make_shared<bool>(false);

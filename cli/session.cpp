@@ -36,12 +36,43 @@ void set_constant_overrides(const std::vector<std::string>& sets) {
     }
 }
 
+namespace {
+
+// A limit set by the environment variable `name`, a whole number of `unit` from 1 to `most`.
+template <class T>
+void limit_from_env(const char* name, const char* unit, double most, T& limit) {
+    const auto v = positive_env(name, unit);
+    if (!v) return;
+    if (*v > most)
+        throw UsageError(
+            fmt::format("{} must be at most {} {}, not '{}'", name, most, unit, std::getenv(name)));
+    limit = static_cast<T>(std::ceil(*v));
+}
+
+} // namespace
+
+front::Limits frontend_limits() {
+    front::Limits l;
+    // The nesting limits stop where the work thread's stack (cli/main.cpp) would no longer hold every
+    // recursive pass.
+    limit_from_env("FRAC_MAX_NESTING", "levels", 100000, l.max_nesting);
+    limit_from_env("FRAC_MAX_OPERATORS", "operators", 500000, l.max_operators);
+    limit_from_env("FRAC_MAX_CALL_DEPTH", "calls", 10000, l.max_inline_depth);
+    limit_from_env("FRAC_MAX_SERIES_NESTING", "series", 1000, l.max_series_nesting);
+    limit_from_env("FRAC_MAX_SERIES_TERMS", "terms", 1e9, l.max_finite_terms);
+    limit_from_env("FRAC_MAX_INLINE_NODES", "expression nodes", 1e18, l.max_inline_nodes);
+    limit_from_env("FRAC_MAX_IMPORT_DEPTH", "files", 10000, l.max_import_depth);
+    std::size_t mib = l.max_file_bytes >> 20;
+    limit_from_env("FRAC_MAX_FILE_MB", "MiB", 1 << 20, mib);
+    l.max_file_bytes = mib << 20;
+    return l;
+}
+
 std::unique_ptr<front::Compilation> compile_or_report(const std::string& path, driver::Stage stop,
                                                       driver::PassTimes* times) {
     driver::CompileOptions options;
     options.stop = stop;
-    if (const auto nodes = positive_env("FRAC_MAX_INLINE_NODES", "expression nodes"))
-        options.limits.max_inline_nodes = static_cast<std::uint64_t>(std::min(*nodes, 1e18));
+    options.limits = frontend_limits();
     options.overrides = constant_overrides;
     options.free_entry_seed = free_entry_seed;
     options.times = times;

@@ -28,6 +28,12 @@ void set_constant_overrides(const std::vector<std::string>& sets);
 // --seed N: every later compile_or_report gives the free entries of a bcifs values drawn from N.
 void set_free_entry_seed(std::optional<std::uint64_t> seed);
 
+// The frontend's limits (frontend/limits.hpp), each raised or lowered by its environment variable
+// (FRAC_MAX_NESTING, FRAC_MAX_OPERATORS, FRAC_MAX_CALL_DEPTH, FRAC_MAX_SERIES_NESTING,
+// FRAC_MAX_SERIES_TERMS, FRAC_MAX_INLINE_NODES, FRAC_MAX_IMPORT_DEPTH, FRAC_MAX_FILE_MB); a UsageError
+// when one is not a number in its range.
+front::Limits frontend_limits();
+
 // Compiles `path`; on errors prints the diagnostics to stderr and returns null.
 // `times`, when not null, gets the time of each stage run.
 std::unique_ptr<front::Compilation> compile_or_report(const std::string& path,

@@ -190,7 +190,7 @@ std::string PassTimes::report() const {
 std::unique_ptr<front::Compilation> compile_file(const std::string& path, const CompileOptions& options) {
     auto c = std::make_unique<front::Compilation>();
     front::LoadTimes load;
-    const bool read = front::load_file(*c, path, &load);
+    const bool read = front::load_file(*c, path, options.limits, &load);
     add_load_times(load, options.times);
     if (!read) return c;
     front::apply_overrides(*c, options.overrides);
@@ -203,7 +203,7 @@ std::unique_ptr<front::Compilation> compile_source(const std::string& name, cons
                                                    const CompileOptions& options) {
     auto c = std::make_unique<front::Compilation>();
     front::LoadTimes load;
-    front::load_source(*c, name, text, &load);
+    front::load_source(*c, name, text, options.limits, &load);
     add_load_times(load, options.times);
     run_frontend(*c, options);
     return c;

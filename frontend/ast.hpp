@@ -3,6 +3,7 @@
 
 #include "frontend/diagnostics.hpp"
 #include "frontend/lexer.hpp"
+#include "frontend/limits.hpp"
 
 #include <cstdint>
 #include <memory>
@@ -198,8 +199,9 @@ struct Program {
     std::vector<Item> items;
 };
 
-// Parses one file's tokens; syntax errors go to `diags`, with recovery at the next item.
-Program parse(const std::vector<Token>& tokens, Diagnostics& diags);
+// Parses one file's tokens; syntax errors go to `diags`, with recovery at the next item. Of `limits`,
+// the nesting of expressions and the operators of a definition.
+Program parse(const std::vector<Token>& tokens, Diagnostics& diags, const Limits& limits = {});
 
 // Text form of the syntax tree (frac check --emit=ast).
 // Only the items of `file` when it is not 0 (imported files' items are left out).

@@ -27,17 +27,47 @@ std::string SourceManager::line_text(Location loc) const {
     return t.substr(pos, end == std::string::npos ? std::string::npos : end - pos);
 }
 
+namespace {
+
+// A message quotes names and numbers of the model between single quotes; a quote of a 10^6-character
+// token is cut to its beginning and its length, so that one error prints a bounded text.
+std::string bounded(std::string message) {
+    constexpr std::size_t max_quote = 80, kept = 60;
+    if (message.size() <= max_quote) return message;
+    std::string out;
+    std::size_t pos = 0;
+    while (pos < message.size()) {
+        const std::size_t open = message.find('\'', pos);
+        const std::size_t close = open == std::string::npos ? open : message.find('\'', open + 1);
+        if (close == std::string::npos) break;
+        out.append(message, pos, open + 1 - pos);
+        const std::size_t length = close - open - 1;
+        if (length > max_quote) {
+            out.append(message, open + 1, kept);
+            out += fmt::format("... ({} characters)", length);
+        } else {
+            out.append(message, open + 1, length);
+        }
+        out += '\'';
+        pos = close + 1;
+    }
+    out.append(message, pos, std::string::npos);
+    return out;
+}
+
+} // namespace
+
 void Diagnostics::error(Location loc, std::string message) {
     ++errors_;
-    if (errors_ <= max_errors) list_.push_back({Severity::error, loc, std::move(message)});
+    if (errors_ <= max_errors) list_.push_back({Severity::error, loc, bounded(std::move(message))});
 }
 
 void Diagnostics::warning(Location loc, std::string message) {
-    list_.push_back({Severity::warning, loc, std::move(message)});
+    list_.push_back({Severity::warning, loc, bounded(std::move(message))});
 }
 
 void Diagnostics::note(Location loc, std::string message) {
-    list_.push_back({Severity::note, loc, std::move(message)});
+    list_.push_back({Severity::note, loc, bounded(std::move(message))});
 }
 
 std::string Diagnostics::render(const SourceManager& sm) const {

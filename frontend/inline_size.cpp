@@ -95,9 +95,10 @@ void check_inline_size(const Program& program, const Limits& limits, Diagnostics
             const double n = size.of(*root);
             if (n <= limit) continue;
             diags.error(it.loc, fmt::format("'{}' inlined has {} expression nodes, more than the limit of "
-                                            "{} (FRAC_MAX_INLINE_NODES raises it): functions calling the "
-                                            "previous one several times multiply at each level",
-                                            it.name, size_text(n), limits.max_inline_nodes));
+                                            "{}{}: functions calling the previous one several times "
+                                            "multiply at each level",
+                                            it.name, size_text(n), limits.max_inline_nodes,
+                                            raised_by("FRAC_MAX_INLINE_NODES")));
             // The chain: from the definition, each time the call of the largest function.
             const Expr* at = root;
             for (int step = 0; step < max_chain_notes; ++step) {

@@ -53,7 +53,8 @@ protected:
                                                    "recursion is not supported (write a series instead)",
                                                    item->name));
         if (static_cast<int>(call_stack_.size()) >= max_depth_)
-            throw CompileError(call_loc, fmt::format("calls nested deeper than the limit of {}", max_depth_));
+            throw CompileError(call_loc, fmt::format("calls nested deeper than the limit of {}{}", max_depth_,
+                                                     raised_by("FRAC_MAX_CALL_DEPTH")));
         frames_.push_back(std::move(frame));
         call_stack_.push_back(item);
         struct Pop {

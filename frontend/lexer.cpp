@@ -192,6 +192,7 @@ private:
             {"*", Tok::star},      {"/", Tok::slash},  {"^", Tok::caret},   {"&", Tok::amp},
             {"|", Tok::bar},       {"~", Tok::tilde},  {"?", Tok::question}};
         for (const Punct& p : puncts) {
+            if (p.text[0] != c) continue; // most tokens are punctuation: no string compare for the others
             const std::string_view text(p.text);
             if (s_.compare(pos_, text.size(), text) == 0) {
                 for (std::size_t k = 0; k < text.size(); ++k) advance();

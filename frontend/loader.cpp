@@ -18,10 +18,7 @@ namespace frac::front {
 
 namespace {
 
-constexpr std::size_t max_file_bytes = 16u << 20;
-constexpr std::size_t max_import_depth = 64; // files open at once along a chain of imports
-
-bool read_file(const std::string& path, std::string& text, std::string& why) {
+bool read_file(const std::string& path, std::size_t max_file_bytes, std::string& text, std::string& why) {
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) {
         why = "is a directory";
@@ -42,7 +39,8 @@ bool read_file(const std::string& path, std::string& text, std::string& why) {
     }
     text.resize(static_cast<std::size_t>(in.gcount()));
     if (text.size() > max_file_bytes) {
-        why = fmt::format("larger than the limit of {} MiB", max_file_bytes >> 20);
+        why = fmt::format("larger than the limit of {} MiB{}", max_file_bytes >> 20,
+                          raised_by("FRAC_MAX_FILE_MB"));
         return false;
     }
     return true;
@@ -139,8 +137,9 @@ private:
 
 class Loader {
 public:
-    Loader(Compilation& c, Program& into, LoadTimes* times, std::vector<std::string>* loading = nullptr)
-        : c_(c), into_(into), times_(times), loading_(loading ? loading : &own_loading_) {}
+    Loader(Compilation& c, Program& into, const Limits& limits, LoadTimes* times,
+           std::vector<std::string>* loading = nullptr)
+        : c_(c), into_(into), limits_(limits), times_(times), loading_(loading ? loading : &own_loading_) {}
 
     // `key` names the file for cycles (its canonical path; empty for text without a file).
     void load(const std::string& name, const std::string& text, const std::filesystem::path& dir,
@@ -156,7 +155,7 @@ public:
         const auto t0 = clock::now();
         std::vector<Token> tokens = lex(text, file, c_.diags);
         const auto t1 = clock::now();
-        Program p = parse(tokens, c_.diags);
+        Program p = parse(tokens, c_.diags, limits_);
         if (times_) {
             times_->lex += std::chrono::duration<double>(t1 - t0).count();
             times_->parse += std::chrono::duration<double>(clock::now() - t1).count();
@@ -170,11 +169,11 @@ public:
 private:
     void import(const Item& it, const std::filesystem::path& dir) {
         const std::string& spec = it.name;
-        if (loading_->size() >= max_import_depth) {
+        if (loading_->size() >= static_cast<std::size_t>(limits_.max_import_depth)) {
             // Each nested import holds its file's text and a frame of the loader.
-            c_.diags.error(it.loc, fmt::format("imports nested deeper than the limit of {} files: import "
+            c_.diags.error(it.loc, fmt::format("imports nested deeper than the limit of {} files{}: import "
                                                "the modules side by side from one file",
-                                               max_import_depth));
+                                               limits_.max_import_depth, raised_by("FRAC_MAX_IMPORT_DEPTH")));
             return;
         }
         const bool library = spec.find('/') == std::string::npos && spec.find(".frac") == std::string::npos;
@@ -217,7 +216,7 @@ private:
                 c_.diags.error(it.loc, fmt::format("cannot import '{}': not a regular file", path.string()));
                 return;
             }
-            if (!read_file(path.string(), text, why)) {
+            if (!read_file(path.string(), limits_.max_file_bytes, text, why)) {
                 c_.diags.error(it.loc, fmt::format("cannot read '{}': {}", path.string(), why));
                 return;
             }
@@ -232,7 +231,7 @@ private:
         // A qualified module is loaded on its own (its imports too), then its names get the prefix: it
         // shares nothing with the importing files but what they reach through the prefix.
         Program module;
-        Loader(c_, module, times_, loading_).load(name, text, module_dir, key);
+        Loader(c_, module, limits_, times_, loading_).load(name, text, module_dir, key);
         Qualifier q(it.alias, module);
         for (Item& m : module.items) {
             q.rename(m);
@@ -242,6 +241,7 @@ private:
 
     Compilation& c_;
     Program& into_;
+    const Limits& limits_;
     LoadTimes* times_;
     std::vector<std::string> own_loading_; // the files being read, outermost first
     std::vector<std::string>* loading_;
@@ -268,8 +268,9 @@ void apply_overrides(Compilation& c, const ConstOverrides& overrides) {
     }
 }
 
-void load_source(Compilation& c, const std::string& name, const std::string& text, LoadTimes* times) {
-    Loader(c, c.program, times).load(name, text, std::filesystem::current_path());
+void load_source(Compilation& c, const std::string& name, const std::string& text, const Limits& limits,
+                 LoadTimes* times) {
+    Loader(c, c.program, limits, times).load(name, text, std::filesystem::current_path());
 }
 
 bool is_identifier(const std::string& text) {
@@ -279,15 +280,15 @@ bool is_identifier(const std::string& text) {
     return true;
 }
 
-bool load_file(Compilation& c, const std::string& path, LoadTimes* times) {
+bool load_file(Compilation& c, const std::string& path, const Limits& limits, LoadTimes* times) {
     std::string text, why;
-    if (!read_file(path, text, why)) {
+    if (!read_file(path, limits.max_file_bytes, text, why)) {
         c.diags.error({}, fmt::format("cannot read '{}': {}", path, why));
         return false;
     }
     std::error_code ec;
     const auto canonical = std::filesystem::weakly_canonical(path, ec);
-    Loader(c, c.program, times)
+    Loader(c, c.program, limits, times)
         .load(path, text, std::filesystem::path(path).parent_path(), ec ? path : canonical.string());
     return true;
 }

@@ -34,9 +34,10 @@ struct LoadTimes {
 
 // Reads, lexes and parses `path` and its imports into c.program. A file that cannot be read is an
 // error in c.diags; returns whether the main file was read.
-bool load_file(Compilation& c, const std::string& path, LoadTimes* times = nullptr);
+// Of `limits`, the size of files, the depth of imports and what the parser limits.
+bool load_file(Compilation& c, const std::string& path, const Limits& limits, LoadTimes* times = nullptr);
 // Same, from text (name is used in diagnostics; imports resolve relative to the working directory).
-void load_source(Compilation& c, const std::string& name, const std::string& text,
+void load_source(Compilation& c, const std::string& name, const std::string& text, const Limits& limits,
                  LoadTimes* times = nullptr);
 
 // Constants replaced before names are resolved (frac --set NAME=VALUE): name, expression text.

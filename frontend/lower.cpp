@@ -1245,14 +1245,16 @@ private:
             if (data.end - data.start + 1 > limits_.max_finite_terms)
                 fail(e.loc,
                      fmt::format(
-                         "this series has {} terms, over the limit of {} (use an infinite series, whose "
-                         "tail is bounded)",
-                         data.end - data.start + 1, limits_.max_finite_terms));
+                         "this series has {} terms, over the limit of {}{}: use an infinite series, whose "
+                         "tail is bounded",
+                         data.end - data.start + 1, limits_.max_finite_terms,
+                         raised_by("FRAC_MAX_SERIES_TERMS")));
         } else if (data.start < 0) {
             fail(e.kids[0]->loc, "an infinite series must start at an index >= 0");
         }
         if (frames_[frame].level + 1 > limits_.max_series_nesting)
-            fail(e.loc, fmt::format("series nested deeper than the limit of {}", limits_.max_series_nesting));
+            fail(e.loc, fmt::format("series nested deeper than the limit of {}{}", limits_.max_series_nesting,
+                                    raised_by("FRAC_MAX_SERIES_NESTING")));
         data.level = ++frames_[frame].level;
         frames_[frame].scopes.emplace_back();
         frames_[frame].scopes.back().emplace_back(e.var, Value::scalar(g_.index(data.level)));

@@ -5,20 +5,13 @@
 #pragma once
 
 #include "frontend/ast.hpp"
+#include "frontend/limits.hpp"
 #include "frontend/module.hpp"
 
 #include <cstdint>
 #include <optional>
 
 namespace frac::front {
-
-struct Limits {
-    int max_finite_terms = 10000; // terms of a finite series
-    int max_inline_depth = 64;    // nested function calls
-    int max_series_nesting = 16;
-    // Expression nodes of a definition with its calls inlined (inline_size.hpp); FRAC_MAX_INLINE_NODES.
-    std::uint64_t max_inline_nodes = 2'000'000;
-};
 
 struct TypedProgram;
 

@@ -10,7 +10,8 @@ namespace {
 
 class Parser {
 public:
-    Parser(const std::vector<Token>& tokens, Diagnostics& diags) : t_(tokens), diags_(diags) {}
+    Parser(const std::vector<Token>& tokens, Diagnostics& diags, const Limits& limits)
+        : t_(tokens), diags_(diags), max_nesting_(limits.max_nesting), max_operators_(limits.max_operators) {}
 
     Program program() {
         Program p;
@@ -526,11 +527,20 @@ private:
         e->loc = loc;
         return e;
     }
+    // A chain a + b + c ... (or a.x.y ...) is a left-deep tree: every later pass recurses along it.
+    void count_operator(Location loc) {
+        if (++operators_ > max_operators_)
+            throw CompileError(loc, fmt::format("this definition has more than the limit of {} operators{}",
+                                                max_operators_, raised_by("FRAC_MAX_OPERATORS")));
+    }
+    // Each level of nesting is a few frames of this parser and of every later pass.
+    void enter(Location loc) {
+        if (++depth_ > max_nesting_)
+            throw CompileError(loc, fmt::format("expression nested deeper than the limit of {} levels{}",
+                                                max_nesting_, raised_by("FRAC_MAX_NESTING")));
+    }
     ExprPtr binary(Tok op, Location loc, ExprPtr a, ExprPtr b) {
-        // A chain a + b + c ... is a left-deep tree: every later pass recurses along it.
-        if (++operators_ > max_operators)
-            throw CompileError(
-                loc, fmt::format("this definition has more than {} operators, the limit", max_operators));
+        count_operator(loc);
         auto e = make(ExprKind::binary, loc);
         e->op = op;
         e->kids.push_back(std::move(a));
@@ -539,7 +549,7 @@ private:
     }
 
     ExprPtr expr() {
-        if (++depth_ > max_nesting) fail(fmt::format("expression nested deeper than {} levels", max_nesting));
+        enter(cur().loc);
         ExprPtr e;
         if (at(Tok::kw_let)) {
             e = make(ExprKind::let, take().loc);
@@ -582,9 +592,11 @@ private:
     }
     ExprPtr not_expr() {
         if (at(Tok::kw_not)) {
+            enter(cur().loc);
             auto e = make(ExprKind::unary, take().loc);
             e->op = Tok::kw_not;
             e->kids.push_back(not_expr());
+            --depth_;
             return e;
         }
         return cmp_expr();
@@ -646,8 +658,7 @@ private:
     }
     ExprPtr unary_expr() {
         if (at(Tok::minus) || at(Tok::plus) || at(Tok::tilde)) {
-            if (++depth_ > max_nesting)
-                fail(fmt::format("expression nested deeper than {} levels", max_nesting));
+            enter(cur().loc);
             const Tok k = cur().kind;
             auto e = make(ExprKind::unary, take().loc);
             e->op = k;
@@ -660,8 +671,12 @@ private:
     ExprPtr power_expr() {
         ExprPtr base = postfix_expr();
         if (at(Tok::caret)) {
+            // Right associative: a^b^c ... nests to the right, counted before the recursion.
+            enter(cur().loc);
             const Location loc = take().loc;
-            return binary(Tok::caret, loc, std::move(base), unary_expr()); // right associative
+            ExprPtr e = binary(Tok::caret, loc, std::move(base), unary_expr());
+            --depth_;
+            return e;
         }
         return base;
     }
@@ -669,6 +684,7 @@ private:
         ExprPtr e = primary();
         while (at(Tok::dot)) {
             const Location loc = take().loc;
+            count_operator(loc);
             auto f = make(ExprKind::field, loc);
             f->text = expect(Tok::ident, "after '.'").text;
             f->kids.push_back(std::move(e));
@@ -824,11 +840,10 @@ private:
         return e;
     }
 
-    static constexpr int max_nesting = 200;
-    static constexpr int max_operators = 200000; // binary operators per definition
-    std::set<std::string> aliases_;              // of this file's qualified imports so far
+    std::set<std::string> aliases_; // of this file's qualified imports so far
     const std::vector<Token>& t_;
     Diagnostics& diags_;
+    int max_nesting_, max_operators_;
     std::size_t pos_ = 0;
     int depth_ = 0;
     int operators_ = 0;
@@ -837,8 +852,8 @@ private:
 
 } // namespace
 
-Program parse(const std::vector<Token>& tokens, Diagnostics& diags) {
-    return Parser(tokens, diags).program();
+Program parse(const std::vector<Token>& tokens, Diagnostics& diags, const Limits& limits) {
+    return Parser(tokens, diags, limits).program();
 }
 
 } // namespace frac::front

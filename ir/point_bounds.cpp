@@ -1,6 +1,7 @@
 #include "ir/point_bounds.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <unordered_map>
@@ -77,14 +78,24 @@ private:
         return {lo, hi_max(lo_pow, hi_pow)};
     }
 
+    // The operation and operands of a node, copied: the graph grows (and moves its nodes) as bounds are
+    // built, so no reference to a node is held across the building.
+    struct Head {
+        Op op;
+        std::array<NodeId, 3> args;
+        std::int64_t imm;
+    };
+
     PointBounds compute(NodeId id) {
-        const Node& n = g_[id];
-        // A constant's point value is a representative of its enclosure (a fold of interval constants
-        // may even give a thin enclosure another point value): its bounds are the enclosure's ends.
-        if (n.op == Op::Const && n.value.is_empty()) return range(std::nan(""), std::nan("")); // undefined
-        if (n.op == Op::Const)
-            return n.value.is_thin() && n.point == n.value.lo ? PointBounds{id, id}
-                                                              : range(n.value.lo, n.value.hi);
+        if (g_[id].op == Op::Const) {
+            // A constant's point value is a representative of its enclosure (a fold of interval constants
+            // may even give a thin enclosure another point value): its bounds are the enclosure's ends.
+            const Interval value = g_[id].value;
+            if (value.is_empty()) return range(std::nan(""), std::nan("")); // undefined
+            return value.is_thin() && g_[id].point == value.lo ? PointBounds{id, id}
+                                                               : range(value.lo, value.hi);
+        }
+        const Head n{g_[id].op, g_[id].args, g_[id].imm};
         if (is_series(n.op) || op_class(n.op) == OpClass::leaf) return {id, id};
         PointBounds a[3];
         bool all_exact = true;
@@ -122,7 +133,7 @@ private:
     }
 
     PointBounds bounds(NodeId id, const PointBounds* a) {
-        const Node& n = g_[id];
+        const Head n{g_[id].op, g_[id].args, g_[id].imm};
         const PointBounds& x = a[0];
         const PointBounds& y = a[1];
         switch (n.op) {

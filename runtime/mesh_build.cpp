@@ -36,7 +36,6 @@
 // Determinism: every step runs in a fixed order (planes, sweep, sorted indices), so the mesh, and
 // the file bytes, depend only on the cover.
 #include "runtime/mesh.hpp"
-#include "runtime/rss.hpp" // max_depth_3d
 
 #include <fmt/format.h>
 
@@ -380,7 +379,7 @@ Lattice make_lattice(const Cover& r, MeshSelection selection) {
     Lattice L;
     L.depth = r.depth;
     L.split = r.split;
-    if (L.depth < 0 || L.depth > max_depth_3d || L.split < 2 || L.split > 4)
+    if (L.depth < 0 || L.split < 2 || L.split > 4)
         throw std::invalid_argument("mesh_cover: the cover's depth or split is out of range");
     L.n = r.cells_per_axis(L.depth);
     // Doubled lattice coordinates (0..2n) must fit in 32 bits; the cell indices too.

@@ -64,10 +64,12 @@ void validate(const ir::Evaluator& f, const std::vector<Interval>& root, const R
     }
     if (o.split < 2 || o.split > 4)
         throw std::invalid_argument(fmt::format("subdivide: split {} is out of range [2, 4]", o.split));
-    const int max_depth = d == 2 ? max_depth_2d : max_depth_3d;
+    const int max_depth = o.max_depth > 0 ? o.max_depth : d == 2 ? max_depth_2d : max_depth_3d;
     if (o.depth < 0 || o.depth > max_depth)
-        throw std::invalid_argument(
-            fmt::format("subdivide: depth {} is out of range [0, {}] in {}D", o.depth, max_depth, d));
+        throw std::invalid_argument(fmt::format(
+            "subdivide: depth {} is out of range [0, {}] in {}D: lower --depth, or raise the limit with "
+            "FRAC_MAX_DEPTH=N",
+            o.depth, max_depth, d));
     if (grid::ipow(o.split, o.depth) > (std::uint64_t{1} << 32))
         throw std::invalid_argument(fmt::format(
             "subdivide: split^depth = {}^{} exceeds 2^32 cells per axis (cell positions are 32-bit)", o.split,

@@ -43,7 +43,10 @@ using RssProgress = std::function<void(int level, std::uint64_t evaluated)>;
 inline constexpr int default_prune_min_remaining = 1;
 
 struct RssOptions {
-    int depth = 8;            // levels of subdivision below the root box
+    int depth = 8; // levels of subdivision below the root box
+    // The most levels allowed; 0: max_depth_2d or max_depth_3d. Above them, only split^depth <= 2^32
+    // bounds it (the CLI's FRAC_MAX_DEPTH; max_cells bounds the memory).
+    int max_depth = 0;
     int split = 2;            // parts per axis and level
     bool keep_cells = true;   // record every evaluated cell (for pictures); false keeps only counts
     std::size_t batch = 4096; // cells per eval_boxes call (>= 1)
@@ -67,8 +70,9 @@ struct RssOptions {
 // frontier of undecided cells beside them) and a few seconds to a minute of evaluation.
 inline constexpr std::uint64_t default_max_cells = std::uint64_t{1} << 27;
 
-// Hard limits, reported as errors when exceeded. Besides, split^depth must not exceed 2^32 (cell
-// positions are 32-bit): with split 3 the depth is at most 20, with split 4 at most 16.
+// Default limits of the depth, reported as errors when exceeded (RssOptions::max_depth raises them).
+// Besides, split^depth must not exceed 2^32 (cell positions are 32-bit): with split 3 the depth is at
+// most 20, with split 4 at most 16.
 inline constexpr int max_depth_2d = 24;
 inline constexpr int max_depth_3d = 14;
 

@@ -569,6 +569,12 @@ num::Interval eval_reference(const Expr& e, const num::Interval* box) {
     throw std::logic_error("eval_reference: unhandled op");
 }
 
+bool Report::covered() const {
+    for (int i = 0; i < kNumOps; ++i)
+        if (op_checked[i] == 0) return false;
+    return points_checked > pairs;
+}
+
 std::string Report::summary() const {
     std::string s = "pairs " + std::to_string(pairs) + ", points checked " + std::to_string(points_checked) +
                     ", skipped " + std::to_string(undefined_skipped) + " undefined, imprecise " +

@@ -129,6 +129,9 @@ struct Report {
 
     // Multi-line human-readable summary: totals and per-op counts.
     std::string summary() const;
+    // Whether the check did not shrink: more points checked than pairs drawn (4 points a pair, a few
+    // undefined), and every operator of the table in some checked expression.
+    bool covered() const;
 };
 
 // For n_pairs random (expression, box) pairs from `seed`: evaluate `enclosure` on the box (it is called

@@ -54,6 +54,10 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(unsound.violations),
                 static_cast<unsigned long long>(unsound.points_checked));
     int failed = 0;
+    if (!sound.covered()) {
+        std::printf("FAIL: the check shrank: too few points defined or an operator never checked\n");
+        ++failed;
+    }
     if (sound.violations != 0 || sound.pairs < pairs) {
         std::printf("FAIL: the interpreter is unsound:\n%s\n", sound.first_violation.c_str());
         ++failed;
@@ -62,6 +66,6 @@ int main(int argc, char** argv) {
         std::printf("FAIL: the check did not catch an evaluator without outward rounding\n");
         ++failed;
     }
-    std::printf("%d passed, %d failed\n", 2 - failed, failed);
+    std::printf("%d passed, %d failed\n", 3 - failed, failed);
     return failed ? 1 : 0;
 }

@@ -115,6 +115,7 @@ int main(int argc, char** argv) {
                     jit::host_has_avx512() ? "avx512 rounding" : "constrained intrinsics",
                     r.summary().c_str(), compiled.compiles(), s);
         check(r.violations == 0 && r.pairs == pairs, "the JIT is unsound", r);
+        check(r.covered(), "the check shrank: too few points defined or an operator never checked", r);
     }
     // The portable form (constrained intrinsics, MXCSR set per call) on a tenth of the pairs, when the
     // default above was the AVX-512 form; scalar code, so both vector widths are covered.
@@ -129,6 +130,7 @@ int main(int argc, char** argv) {
                     static_cast<unsigned long long>(r.points_checked),
                     static_cast<unsigned long long>(r.violations));
         check(r.violations == 0 && r.pairs == pairs / 10, "the portable JIT form is unsound", r);
+        check(r.covered(), "the check shrank: too few points defined or an operator never checked", r);
     }
     // The harness must reject JIT point values posing as enclosures.
     {

@@ -152,12 +152,7 @@ TEST_CASE("the numeric core is sound on random expressions and boxes", "[soundne
         options);
     INFO(report.summary());
     CHECK(report.violations == 0);
-    // Every builtin must have been checked at some point.
-    for (int i = 0; i < oracle::kNumOps; ++i) {
-        INFO(oracle::op_name(static_cast<Op>(i)));
-        CHECK(report.op_checked[i] > 0);
-    }
-    CHECK(report.points_checked > report.pairs);
+    CHECK(report.covered()); // every builtin checked at some point, most points defined
 }
 
 TEST_CASE("the oracle catches naive round-to-nearest interval arithmetic", "[soundness]") {

@@ -99,6 +99,37 @@ TEST_CASE("deeply nested input is an error, not a stack overflow", "[parser][lim
     std::string minus = "const c = " + std::string(100000, '-') + "1;";
     ast_of(minus, &errors);
     CHECK(errors.find("nested deeper than") != std::string::npos);
+    // `not` and the right-associative `^` nest too (a chain of 10^5 overflowed the stack).
+    std::string nots = "const c = ", powers = "const c = 2";
+    for (int i = 0; i < 100000; ++i) {
+        nots += "not ";
+        powers += "^2";
+    }
+    for (const std::string& text : {nots + "1 < 2;", powers + ";"}) {
+        ast_of(text, &errors);
+        CHECK(errors.find("nested deeper than the limit of 200 levels (FRAC_MAX_NESTING raises it)") !=
+              std::string::npos);
+    }
+}
+
+TEST_CASE("operators and field accesses of a definition are limited", "[parser][limits]") {
+    Limits limits;
+    limits.max_operators = 100;
+    std::string fields = "const c = p", sum = "const c = 1";
+    for (int i = 0; i < 101; ++i) {
+        fields += ".x";
+        sum += " + 1";
+    }
+    for (const std::string& text : {fields + ";", sum + ";"}) {
+        Diagnostics d;
+        parse(lex(text, 1, d), d, limits);
+        REQUIRE(d.error_count() == 1);
+        CHECK(d.all()[0].message ==
+              "this definition has more than the limit of 100 operators (FRAC_MAX_OPERATORS raises it)");
+    }
+    Diagnostics d;
+    parse(lex(sum.substr(0, sum.size() - 4) + ";", 1, d), d, limits); // 100 operators
+    CHECK_FALSE(d.has_errors());
 }
 
 TEST_CASE("the unicode box operator is a token", "[lexer]") {
@@ -107,4 +138,14 @@ TEST_CASE("the unicode box operator is a token", "[lexer]") {
     REQUIRE_FALSE(d.has_errors());
     CHECK(toks[5].kind == Tok::times);
     CHECK(toks[6].loc.column == 9); // columns count characters, not bytes
+}
+
+TEST_CASE("a long quoted token is cut in a message", "[diagnostics][limits]") {
+    Diagnostics d;
+    d.error({}, "unknown name '" + std::string(1000000, 'b') + "'; did you mean 'a'?");
+    REQUIRE(d.all().size() == 1);
+    CHECK(d.all()[0].message ==
+          "unknown name '" + std::string(60, 'b') + "... (1000000 characters)'; did you mean 'a'?");
+    d.error({}, "number '" + std::string(80, '9') + "' is too large"); // short enough: whole
+    CHECK(d.all()[1].message == "number '" + std::string(80, '9') + "' is too large");
 }

@@ -1,0 +1,32 @@
+// The frontend's limits. Each is reported with its value and the environment variable that raises it
+// (read by the CLI, cli/session.cpp); the defaults keep every recursive pass within the stack and a bad
+// model within a second.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace frac::front {
+
+struct Limits {
+    // Expression nesting: parentheses, calls, let, if, prefix operators, `not`, `^` (FRAC_MAX_NESTING).
+    int max_nesting = 200;
+    // Binary operators and field accesses of one definition (FRAC_MAX_OPERATORS): a chain a + b + ... is a
+    // left-deep tree that every later pass recurses along.
+    int max_operators = 200000;
+    int max_finite_terms = 10000; // terms of a finite series (FRAC_MAX_SERIES_TERMS)
+    int max_inline_depth = 64;    // nested function calls (FRAC_MAX_CALL_DEPTH)
+    int max_series_nesting = 16;  // FRAC_MAX_SERIES_NESTING
+    // Expression nodes of a definition with its calls inlined (inline_size.hpp; FRAC_MAX_INLINE_NODES).
+    std::uint64_t max_inline_nodes = 2'000'000;
+    int max_import_depth = 64;                          // files open at once along a chain of imports
+    std::size_t max_file_bytes = std::size_t{16} << 20; // of a model file (FRAC_MAX_FILE_MB, in MiB)
+};
+
+// "(NAME raises it)", the end of a limit's message.
+inline std::string raised_by(const char* env) {
+    return std::string(" (") + env + " raises it)";
+}
+
+} // namespace frac::front

@@ -1,0 +1,27 @@
+# The hostile catalogue, written into the current directory by make_hostile_catalogue: one NAME.frac per
+# input (import_cycle_b.frac is imported by import_cycle.frac, not checked on its own). Sourced by
+# tests/robustness/hostile_inputs.sh (the verdicts) and bench/hostile_times.sh (the times).
+make_hostile_catalogue() {
+    repeat() { head -c "$2" < /dev/zero | tr '\0' "$1"; } # CHAR COUNT
+    { printf 'shape s(x, y) = '; repeat '(' 100000; printf x; repeat ')' 100000; printf ';\n'; } > parens_1e5.frac
+    { printf 'shape s(x, y) = '; repeat '(' 1000000; printf x; repeat ')' 1000000; printf ';\n'; } > parens_1e6.frac
+    { printf 'shape s(x, y) = '; repeat '-' 1000000; printf 'x;\n'; } > minus_1e6.frac
+    { printf 'shape s(x, y) = if '; repeat '!' 1000000 | sed 's/!/not /g'; printf 'x < y then x else y;\n'; } > not_1e6.frac
+    { printf 'shape s(x, y) = '; repeat '!' 100000 | sed 's/!/let a = x in /g'; printf 'a;\n'; } > let_1e5.frac
+    { printf 'shape s(x, y) = '; repeat 'f' 100000 | sed 's/f/f(/g'; printf x; repeat ')' 100000; printf ';\n'; } > calls_1e5.frac
+    { printf 'shape s(x, y) = x'; repeat '^' 300000 | sed 's/\^/^x/g'; printf ';\n'; } > power_chain_3e5.frac
+    { printf 'shape s(x, y) = x'; repeat '+' 1000000 | sed 's/+/ + x/g'; printf ';\n'; } > plus_chain_1e6.frac
+    { printf 'shape s(x, y) = x'; repeat '.' 1000000 | sed 's/\./.x/g'; printf ';\n'; } > field_chain_1e6.frac
+    { printf 'shape s(x, y) = x + '; repeat 9 1000000; printf ';\nshape t(x, y) = 1e999999999 - x;\n'; } > huge_literal.frac
+    { printf 'shape s(x, y) = x '; printf '\xff\xfe\xc3\x28 '; printf '+ y;\n'; } > invalid_utf8.frac
+    { printf 'shape s(x, y) = x\0 + y;\n'; } > nul_byte.frac
+    head -c 100000 /dev/urandom > binary_garbage.frac
+    { printf 'shape '; repeat a 1000000; printf '(x, y) = '; repeat b 1000000; printf ';\n'; } > identifier_1e6.frac
+    { printf 'fn f(x) = g(x);\nfn g(x) = f(x);\nshape s(x, y) = f(x);\n'; } > mutual_recursion.frac
+    { printf 'import "import_cycle_b.frac";\nshape s(x, y) = x;\n'; } > import_cycle.frac
+    { printf 'import "import_cycle.frac";\nshape t(x, y) = y;\n'; } > import_cycle_b.frac
+    { echo 'fn f0(x) = x * 0.5;'; for i in $(seq 1 30); do echo "fn f$i(x) = f$((i - 1))(x) + f$((i - 1))(x + 1);"; done; echo 'shape s(x, y) = f30(x) - y;'; } > inline_explosion.frac
+    { printf 'import "/proc/self/mem";\nimport "/dev/urandom";\nshape s(x, y) = x;\n'; } > special_imports.frac
+    { printf 'import "/dev/zero";\nshape s(x, y) = x;\n'; } > import_dev_zero.frac
+    { printf 'import "/tmp";\nshape s(x, y) = x;\n'; } > import_directory.frac
+}
