@@ -1,5 +1,5 @@
-// The JIT's inline interval kernels (sqrt, sin, cos: backend/llvm/box_kernels.cpp) against the calls into
-// the numeric core they replace (FRAC_JIT_EXACT_CALLS=1 at compile time) and against the interpreter,
+// The JIT's inline interval kernels (sqrt, sin, cos, exp: backend/llvm/box_kernels.cpp) against the calls
+// into the numeric core they replace (FRAC_JIT_EXACT_CALLS=1 at compile time) and against the interpreter,
 // every variant in this one run, repetitions interleaved, medians:
 //  1. octree covers (one thread) of the scenes of bench/kernel_scenes.frac: a gyroid sheet in a ball
 //     (sin, cos, sqrt) and spheres and boxes in CSG (sqrt); the covers of the variants compared cell by cell;
@@ -157,5 +157,6 @@ int main(int argc, char** argv) {
     kernel("sqrt", ir::Op::Sqrt, reps);
     kernel("sin", ir::Op::Sin, reps);
     kernel("cos", ir::Op::Cos, reps);
+    kernel("exp", ir::Op::Exp, reps);
     return 0;
 }

@@ -83,12 +83,7 @@ IV BoxGen::with_fallback(Value* fast_lanes, IV fast, Op op, const std::vector<co
     b_.SetInsertPoint(slow_bb);
     IV rs;
     if (w_ == 1) {
-        std::vector<Value*> flat;
-        for (const SlotState* a : args) {
-            flat.push_back(a->v.lo);
-            flat.push_back(a->v.hi);
-        }
-        rs = call_scalar(helper_name(op), flat);
+        rs = call_core(op, 0, args, true).v;
     } else {
         std::vector<IV> v;
         for (const SlotState* a : args) v.push_back(a->v);

@@ -86,7 +86,7 @@ public:
         }
     }
 
-    // FRAC_JIT_EXACT_CALLS=1 in the environment: sqrt, sin and cos call the numeric core (correctly
+    // FRAC_JIT_EXACT_CALLS=1 in the environment: sqrt, sin, cos and exp call the numeric core (correctly
     // rounded, bit for bit the interpreter's) instead of the inline kernels; for benchmarks and tests.
     static bool exact_calls_requested() {
         const char* v = std::getenv("FRAC_JIT_EXACT_CALLS");
@@ -343,6 +343,9 @@ private:
     SlotState op_sincos(const SlotState& a, bool is_cos);
     // Enclosure of sin(x) (shift 0) or cos(x) (shift 1) at a point x with |x| <= trig_fast_limit.
     IV sincos_point(Value* x, int shift);
+    SlotState op_exp(const SlotState& a);
+    // An approximation of exp(x) for |x| <= 700, relative error below 2^-46.
+    Value* exp_value(Value* x);
     SlotState op_powi(const SlotState& a, std::int64_t n);
     SlotState op_minmax(const SlotState& a, const SlotState& b, bool is_min);
     SlotState op_round(const SlotState& a, bool up);
@@ -390,7 +393,7 @@ private:
     SlotState emit_series(const Instr& ins);
 
     bool avx512_;
-    bool fast_kernels_; // inline sqrt, sin and cos (FRAC_JIT_EXACT_CALLS=1: the numeric core's calls)
+    bool fast_kernels_; // inline sqrt, sin, cos, exp (FRAC_JIT_EXACT_CALLS=1: the numeric core's calls)
     Type *vt_, *mt_, *vi64_;
     Value* scratch_in_ = nullptr;
     Value* scratch_n_ = nullptr;

@@ -1,7 +1,9 @@
 // Interval kernels of box code computed inline in vector form instead of calling the numeric core lane
 // by lane (see box_gen.hpp): sqrt with directed rounding, sin and cos by range reduction and
-// polynomials with a proven error bound. Lanes a kernel cannot handle call the core.
+// polynomials with a proven error bound, exp likewise. Lanes a kernel cannot handle call the core.
 #include "backend/llvm/box_gen.hpp"
+
+#include <iterator>
 
 namespace frac::jit::box {
 
@@ -38,7 +40,59 @@ constexpr double rel_bound = 0x1p-48;
 constexpr double abs_per_k = 0x1p-100;
 constexpr double abs_floor = 0x1p-1060;
 
+// exp: fast lanes have -700 <= lo <= hi <= 700, so every value and 2^k are normal doubles.
+constexpr double exp_fast_limit = 700;
+// ln 2 = L1 + L2 + L3, L1 = RN(ln 2), L2 = RN(ln 2 - L1), |L3| < 2^-110.
+constexpr double ln2_1 = 0x1.62e42fefa39efp-1;
+constexpr double ln2_2 = 0x1.abc9e3b39803fp-56;
+constexpr double inv_ln2 = 0x1.71547652b82fep+0;
+// Taylor coefficients RN(1/n!), n = 14 .. 0.
+constexpr double exp_coeffs[] = {0x1.93974a8c07c9dp-37,
+                                 0x1.6124613a86d09p-33,
+                                 0x1.1eed8eff8d898p-29,
+                                 0x1.ae64567f544e4p-26,
+                                 0x1.27e4fb7789f5cp-22,
+                                 0x1.71de3a556c734p-19,
+                                 0x1.a01a01a01a01ap-16,
+                                 0x1.a01a01a01a01ap-13,
+                                 0x1.6c16c16c16c17p-10,
+                                 0x1.1111111111111p-7,
+                                 0x1.5555555555555p-5,
+                                 0x1.5555555555555p-3,
+                                 0x1p-1,
+                                 0x1p+0,
+                                 0x1p+0};
+// |v - exp(x)| <= exp_rel_bound v (docs/design.md, "Vector interval kernels").
+constexpr double exp_rel_bound = 0x1p-46;
+
 } // namespace
+
+Value* BoxGen::exp_value(Value* x) {
+    // k = an integer near x / ln 2; r = x - k ln 2 with |r| < 0.347; exp(x) = 2^k exp(r).
+    Value* k = floor(add(mul(x, cst(inv_ln2)), cst(0.5)));
+    Value* nk = neg(k);
+    Value* r = fma(nk, cst(ln2_2), fma(nk, cst(ln2_1), x)); // the inner fma is exact
+    Value* p = cst(exp_coeffs[0]);
+    for (std::size_t i = 1; i < std::size(exp_coeffs); ++i) p = fma(p, r, cst(exp_coeffs[i]));
+    // 2^k from its bits (|k| <= 1010: a normal double); the product is exact.
+    Value* bits =
+        b_.CreateShl(b_.CreateAdd(b_.CreateFPToSI(k, vi64_), llvm::ConstantInt::get(vi64_, 1023)), 52);
+    return mul(p, b_.CreateBitCast(bits, vt_));
+}
+
+SlotState BoxGen::op_exp(const SlotState& a) {
+    const IV& x = a.v;
+    Value* fast = land(le(x.lo, x.hi), land(ge(x.lo, cst(-exp_fast_limit)), le(x.hi, cst(exp_fast_limit))));
+    // exp is increasing: the lower bound at lo, the upper one at hi.
+    Value* at_lo = exp_value(x.lo);
+    Value* at_hi = exp_value(x.hi);
+    // exp 0 = 1 is exact (r = 0, the polynomial gives 1), and kept thin as in sincos_point.
+    auto err = [&](Value* at, Value* arg) {
+        return sel(eq(arg, cst(0.0)), cst(0.0), mul(at, cst(exp_rel_bound)));
+    };
+    const IV r{std_max(sub_down(at_lo, err(at_lo, x.lo)), cst(0.0)), add(at_hi, err(at_hi, x.hi))};
+    return result(with_fallback(fast, r, Op::Exp, {&a}), a.f.maybe_empty);
+}
 
 IV BoxGen::sincos_point(Value* x, int shift) {
     // k = an integer near x / (pi/2); r = x - k pi/2 with |r| < 0.786.
@@ -60,6 +114,10 @@ IV BoxGen::sincos_point(Value* x, int shift) {
     Value* v = sel(odd, c, s);
     v = sel(ge(q, cst(2.0)), neg(v), v);
     Value* err = add(add(mul(fabs(v), cst(rel_bound)), mul(fabs(k), cst(abs_per_k))), cst(abs_floor));
+    // At x = 0 the values 0 and 1 are exact (r = z = 0); elsewhere sin x and cos x are transcendental
+    // (Lindemann), never a double. Keeping sin 0 and cos 0 thin keeps what depends on thinness (pow's
+    // integer exponents, equality) as the interpreter has it.
+    err = sel(eq(x, cst(0.0)), cst(0.0), err);
     return {sub_down(v, err), add(v, err)};
 }
 
