@@ -4,8 +4,6 @@
 
 #include "engines.hpp"
 
-#include <cstdlib>
-
 namespace frac::test {
 
 struct CrossCheckResult {
@@ -38,15 +36,6 @@ inline bool has_loose_kernel(const ir::Tape& tape) {
         for (const ir::Instr& ins : block)
             if (ins.op == ir::Op::Sin || ins.op == ir::Op::Cos || ins.op == ir::Op::Exp) return true;
     return false;
-}
-
-// The JIT that calls the numeric core for every kernel (FRAC_JIT_EXACT_CALLS=1): the interpreter's bits.
-inline std::unique_ptr<ir::Evaluator>
-make_jit_exact_calls(const ir::Tape& tape, const ir::EvalOptions& options, const jit::JitConfig& config) {
-    setenv("FRAC_JIT_EXACT_CALLS", "1", 1);
-    auto e = jit::make_jit(tape, options, config);
-    unsetenv("FRAC_JIT_EXACT_CALLS");
-    return e;
 }
 
 // Tapes with a loose kernel: the JIT with the core's calls agrees bit for bit (cross_check), and the
