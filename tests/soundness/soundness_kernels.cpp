@@ -154,29 +154,23 @@ public:
     mpfr_t v;
 };
 
-ExactRange sqrt_range(double lo, double hi) {
-    if (hi < 0) return {false}; // the result must be empty
+// The range of an increasing function over [lo, hi]: [RD(f(lo)), RU(f(hi))] (MPFR rounds correctly).
+using MpfrFunction = int (*)(mpfr_ptr, mpfr_srcptr, mpfr_rnd_t);
+ExactRange increasing_range(MpfrFunction f, double lo, double hi) {
     Mpfr x, r;
     ExactRange e;
-    mpfr_set_d(x.v, std::max(lo, 0.0), MPFR_RNDN);
-    mpfr_sqrt(r.v, x.v, MPFR_RNDD);
+    mpfr_set_d(x.v, lo, MPFR_RNDN);
+    f(r.v, x.v, MPFR_RNDD);
     e.lo = mpfr_get_d(r.v, MPFR_RNDD);
     mpfr_set_d(x.v, hi, MPFR_RNDN);
-    mpfr_sqrt(r.v, x.v, MPFR_RNDU);
+    f(r.v, x.v, MPFR_RNDU);
     e.hi = mpfr_get_d(r.v, MPFR_RNDU);
     return e;
 }
 
-ExactRange exp_range(double lo, double hi) {
-    Mpfr x, r;
-    ExactRange e;
-    mpfr_set_d(x.v, lo, MPFR_RNDN);
-    mpfr_exp(r.v, x.v, MPFR_RNDD);
-    e.lo = mpfr_get_d(r.v, MPFR_RNDD);
-    mpfr_set_d(x.v, hi, MPFR_RNDN);
-    mpfr_exp(r.v, x.v, MPFR_RNDU);
-    e.hi = mpfr_get_d(r.v, MPFR_RNDU);
-    return e;
+ExactRange sqrt_range(double lo, double hi) {
+    if (hi < 0) return {false}; // the result must be empty
+    return increasing_range(mpfr_sqrt, std::max(lo, 0.0), hi);
 }
 
 // ceil (up = true) or floor of x / (pi/2), decided exactly: x is a double, so x / (pi/2) is an integer
@@ -369,7 +363,7 @@ int main(int argc, char** argv) {
             in[i] = maker.next();
             if (in[i].is_empty()) continue;
             exact[i] = k.op == ir::Op::Sqrt  ? sqrt_range(in[i].lo, in[i].hi)
-                       : k.op == ir::Op::Exp ? exp_range(in[i].lo, in[i].hi)
+                       : k.op == ir::Op::Exp ? increasing_range(mpfr_exp, in[i].lo, in[i].hi)
                                              : sincos_range(in[i].lo, in[i].hi, k.op == ir::Op::Cos);
         }
         ir::Graph g;
