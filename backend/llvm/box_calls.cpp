@@ -39,6 +39,25 @@ IV BoxGen::call_vector(Op op, std::int64_t imm, const std::vector<IV>& args, Val
                           b_.CreateConstInBoundsGEP1_64(dbl_, scratch_out_, static_cast<std::uint64_t>(w_)))};
 }
 
+namespace {
+const char* helper_name(Op op) {
+    switch (op) {
+    case Op::Div: return "frac_jit_div";
+    case Op::Pow: return "frac_jit_pow";
+    case Op::Atan2: return "frac_jit_atan2";
+    case Op::Sqrt: return "frac_jit_sqrt";
+    case Op::Sin: return "frac_jit_sin";
+    case Op::Cos: return "frac_jit_cos";
+    case Op::Tan: return "frac_jit_tan";
+    case Op::Exp: return "frac_jit_exp";
+    case Op::Log: return "frac_jit_log";
+    case Op::PowI: return "frac_jit_powi";
+    default: break;
+    }
+    throw std::logic_error(std::string("jit: no helper for ") + ir::op_name(op));
+}
+} // namespace
+
 SlotState BoxGen::call_core(Op op, std::int64_t imm, const std::vector<const SlotState*>& args,
                             bool maybe_empty) {
     if (w_ > 1) {
@@ -51,24 +70,36 @@ SlotState BoxGen::call_core(Op op, std::int64_t imm, const std::vector<const Slo
         flat.push_back(a->v.lo);
         flat.push_back(a->v.hi);
     }
-    const char* name = nullptr;
-    switch (op) {
-    case Op::Div: name = "frac_jit_div"; break;
-    case Op::Pow: name = "frac_jit_pow"; break;
-    case Op::Atan2: name = "frac_jit_atan2"; break;
-    case Op::Sqrt: name = "frac_jit_sqrt"; break;
-    case Op::Sin: name = "frac_jit_sin"; break;
-    case Op::Cos: name = "frac_jit_cos"; break;
-    case Op::Tan: name = "frac_jit_tan"; break;
-    case Op::Exp: name = "frac_jit_exp"; break;
-    case Op::Log: name = "frac_jit_log"; break;
-    case Op::PowI:
-        name = "frac_jit_powi";
-        flat.push_back(b_.getInt64(static_cast<std::uint64_t>(imm)));
-        break;
-    default: throw std::logic_error(std::string("jit: no helper for ") + ir::op_name(op));
+    if (op == Op::PowI) flat.push_back(b_.getInt64(static_cast<std::uint64_t>(imm)));
+    return result(call_scalar(helper_name(op), flat), maybe_empty);
+}
+
+IV BoxGen::with_fallback(Value* fast_lanes, IV fast, Op op, const std::vector<const SlotState*>& args) {
+    Value* slow = land(ctx_mask_, lnot(fast_lanes));
+    BasicBlock* pre = b_.GetInsertBlock();
+    BasicBlock* slow_bb = BasicBlock::Create(ctx_, "core.call", fn_);
+    BasicBlock* join = BasicBlock::Create(ctx_, "core.join", fn_);
+    b_.CreateCondBr(any(slow), slow_bb, join);
+    b_.SetInsertPoint(slow_bb);
+    IV rs;
+    if (w_ == 1) {
+        rs = call_core(op, 0, args, true).v;
+    } else {
+        std::vector<IV> v;
+        for (const SlotState* a : args) v.push_back(a->v);
+        const IV core = call_vector(op, 0, v, slow);
+        rs = {sel(slow, core.lo, fast.lo), sel(slow, core.hi, fast.hi)};
     }
-    return result(call_scalar(name, flat), maybe_empty);
+    BasicBlock* slow_end = b_.GetInsertBlock();
+    b_.CreateBr(join);
+    b_.SetInsertPoint(join);
+    llvm::PHINode* lo = b_.CreatePHI(vt_, 2);
+    llvm::PHINode* hi = b_.CreatePHI(vt_, 2);
+    lo->addIncoming(fast.lo, pre);
+    lo->addIncoming(rs.lo, slow_end);
+    hi->addIncoming(fast.hi, pre);
+    hi->addIncoming(rs.hi, slow_end);
+    return {lo, hi};
 }
 
 SlotState BoxGen::call_external(std::int64_t k, const SlotState& a, const SlotState& b, const SlotState& c) {

@@ -30,6 +30,7 @@
 #include <llvm/IR/IntrinsicsX86.h>
 #include <llvm/IR/Module.h>
 
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -68,7 +69,8 @@ class BoxGen : public Skeleton<BoxGen, SlotState> {
 public:
     BoxGen(const Tape& t, const ir::EvalOptions& o, const Tables& tab, llvm::Module& m, std::string name,
            Rounding rounding, int lanes)
-        : Skeleton(t, o, tab, m, std::move(name), lanes), avx512_(rounding == Rounding::avx512) {
+        : Skeleton(t, o, tab, m, std::move(name), lanes), avx512_(rounding == Rounding::avx512),
+          fast_kernels_(!exact_calls_requested()) {
         if (avx512_ && w_ != 1 && w_ != 8) throw std::logic_error("jit: AVX-512 rounding needs 1 or 8 lanes");
         vt_ =
             w_ == 1 ? dbl_ : static_cast<Type*>(llvm::FixedVectorType::get(dbl_, static_cast<unsigned>(w_)));
@@ -82,6 +84,13 @@ public:
             b_.setDefaultConstrainedRounding(llvm::RoundingMode::TowardPositive);
             b_.setDefaultConstrainedExcept(llvm::fp::ebIgnore);
         }
+    }
+
+    // FRAC_JIT_EXACT_CALLS=1 in the environment: sqrt, sin, cos and exp call the numeric core (correctly
+    // rounded, bit for bit the interpreter's) instead of the inline kernels; for benchmarks and tests.
+    static bool exact_calls_requested() {
+        const char* v = std::getenv("FRAC_JIT_EXACT_CALLS");
+        return v && std::string(v) == "1";
     }
 
 private:
@@ -123,6 +132,7 @@ private:
     }
     // ---- floating point, rounded upward ----
     static constexpr int ru_sae = 2 | 8; // _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC
+    static constexpr int rd_sae = 1 | 8; // _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC
     Value* x86_round(llvm::Intrinsic::ID scalar, llvm::Intrinsic::ID packed, Value* x, Value* y) {
         if (w_ == 8) {
             Function* f = llvm::Intrinsic::getDeclaration(&m_, packed);
@@ -155,6 +165,46 @@ private:
         using namespace llvm::Intrinsic;
         return avx512_ ? x86_round(x86_avx512_mask_div_sd_round, x86_avx512_div_pd_512, x, y)
                        : b_.CreateFDiv(x, y);
+    }
+    // x * y + z with one rounding (upward).
+    Value* fma(Value* x, Value* y, Value* z) {
+        using namespace llvm::Intrinsic;
+        if (!avx512_)
+            return b_.CreateConstrainedFPCall(
+                llvm::Intrinsic::getDeclaration(&m_, experimental_constrained_fma, {vt_}), {x, y, z});
+        Function* f =
+            llvm::Intrinsic::getDeclaration(&m_, w_ == 8 ? x86_avx512_vfmadd_pd_512 : x86_avx512_vfmadd_f64);
+        return b_.CreateCall(f, {x, y, z, b_.getInt32(ru_sae)});
+    }
+    // The square root rounded up / down. IEEE sqrt is correctly rounded, so both are the exact bounds
+    // the interpreter computes (numeric/interval.cpp: RU(sqrt x), and one double below it when
+    // RU(sqrt x)^2 > x, which the fma decides exactly).
+    Value* sqrt_up(Value* x) {
+        if (avx512_) return x86_sqrt(x, ru_sae);
+        return b_.CreateConstrainedFPCall(
+            llvm::Intrinsic::getDeclaration(&m_, llvm::Intrinsic::experimental_constrained_sqrt, {vt_}), {x});
+    }
+    Value* sqrt_down(Value* x) {
+        if (avx512_) return x86_sqrt(x, rd_sae);
+        Value* r = sqrt_up(x);
+        return sel(gt(fma(r, r, neg(x)), cst(0.0)), next_down_positive(r), r);
+    }
+    Value* x86_sqrt(Value* x, int rounding) {
+        if (w_ == 8)
+            return b_.CreateCall(
+                llvm::Intrinsic::getDeclaration(&m_, llvm::Intrinsic::x86_avx512_sqrt_pd_512),
+                {x, b_.getInt32(static_cast<std::uint32_t>(rounding))});
+        auto* v2 = llvm::FixedVectorType::get(dbl_, 2);
+        Value* a = b_.CreateInsertElement(llvm::ConstantAggregateZero::get(v2), x, b_.getInt64(0));
+        Function* f = llvm::Intrinsic::getDeclaration(&m_, llvm::Intrinsic::x86_avx512_mask_sqrt_sd);
+        Value* r =
+            b_.CreateCall(f, {a, a, a, b_.getInt8(0xff), b_.getInt32(static_cast<std::uint32_t>(rounding))});
+        return b_.CreateExtractElement(r, b_.getInt64(0));
+    }
+    // The double below a positive finite x (its bits minus one).
+    Value* next_down_positive(Value* x) {
+        return b_.CreateBitCast(b_.CreateSub(b_.CreateBitCast(x, vi64_), llvm::ConstantInt::get(vi64_, 1)),
+                                vt_);
     }
     Value* neg(Value* x) { return b_.CreateFNeg(x); }
     Value* add_down(Value* x, Value* y) { return neg(sub(neg(x), y)); }
@@ -268,6 +318,9 @@ private:
     IV call_scalar(const char* helper, std::vector<Value*> args);
     IV call_vector(Op op, std::int64_t imm, const std::vector<IV>& args, Value* mask);
     SlotState call_core(Op op, std::int64_t imm, const std::vector<const SlotState*>& args, bool maybe_empty);
+    // `fast` computed inline where the lane's bit in `fast_lanes` is set; the other lanes of the context
+    // call the numeric core (the branch is skipped when no lane needs it).
+    IV with_fallback(Value* fast_lanes, IV fast, Op op, const std::vector<const SlotState*>& args);
     // Op::External: the tape's function k, out of line (frac_jit_external, lane by lane in vector code).
     SlotState call_external(std::int64_t k, const SlotState& a, const SlotState& b, const SlotState& c);
 
@@ -285,6 +338,14 @@ private:
     Value* pow_down(Value* x, std::uint64_t n);
     IV pow_positive(IV a, std::uint64_t n);
     SlotState op_sqr(const SlotState& a);
+    SlotState op_sqrt(const SlotState& a);
+    // sin or cos of a lane's interval: vector range reduction and polynomials (box_kernels.cpp).
+    SlotState op_sincos(const SlotState& a, bool is_cos);
+    // Enclosure of sin(x) (shift 0) or cos(x) (shift 1) at a point x with |x| <= trig_fast_limit.
+    IV sincos_point(Value* x, int shift);
+    SlotState op_exp(const SlotState& a);
+    // An approximation of exp(x) for |x| <= 700, relative error below 2^-46.
+    Value* exp_value(Value* x);
     SlotState op_powi(const SlotState& a, std::int64_t n);
     SlotState op_minmax(const SlotState& a, const SlotState& b, bool is_min);
     SlotState op_round(const SlotState& a, bool up);
@@ -332,6 +393,7 @@ private:
     SlotState emit_series(const Instr& ins);
 
     bool avx512_;
+    bool fast_kernels_; // inline sqrt, sin, cos, exp (FRAC_JIT_EXACT_CALLS=1: the numeric core's calls)
     Type *vt_, *mt_, *vi64_;
     Value* scratch_in_ = nullptr;
     Value* scratch_n_ = nullptr;

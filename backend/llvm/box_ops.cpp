@@ -68,30 +68,8 @@ SlotState BoxGen::op_div(const SlotState& a, const SlotState& b) {
     Value* pos = gt(b.v.lo, cst(0.0));
     Value* fast = b_.CreateOr(pos, lt(b.v.hi, cst(0.0)));
     if (Value* e = lor(empty_of(a), empty_of(b))) fast = land(fast, lnot(e));
-    const IV rf = div_nonzero(a, b, pos); // garbage in the other lanes, replaced below
-    Value* slow = land(ctx_mask_, lnot(fast));
-    BasicBlock* pre = b_.GetInsertBlock();
-    BasicBlock* slow_bb = BasicBlock::Create(ctx_, "div.slow", fn_);
-    BasicBlock* join = BasicBlock::Create(ctx_, "div.join", fn_);
-    b_.CreateCondBr(any(slow), slow_bb, join);
-    b_.SetInsertPoint(slow_bb);
-    IV rs;
-    if (w_ == 1) {
-        rs = call_scalar("frac_jit_div", {a.v.lo, a.v.hi, b.v.lo, b.v.hi});
-    } else {
-        const IV core = call_vector(Op::Div, 0, {a.v, b.v}, slow);
-        rs = {sel(slow, core.lo, rf.lo), sel(slow, core.hi, rf.hi)};
-    }
-    BasicBlock* slow_end = b_.GetInsertBlock();
-    b_.CreateBr(join);
-    b_.SetInsertPoint(join);
-    llvm::PHINode* lo = b_.CreatePHI(vt_, 2);
-    llvm::PHINode* hi = b_.CreatePHI(vt_, 2);
-    lo->addIncoming(rf.lo, pre);
-    lo->addIncoming(rs.lo, slow_end);
-    hi->addIncoming(rf.hi, pre);
-    hi->addIncoming(rs.hi, slow_end);
-    return result({lo, hi}, true);
+    const IV rf = div_nonzero(a, b, pos); // garbage in the other lanes, replaced by the core's results
+    return result(with_fallback(fast, rf, Op::Div, {&a, &b}), true);
 }
 
 SlotState BoxGen::op_neg(const SlotState& a) {
@@ -260,13 +238,17 @@ SlotState BoxGen::emit_op(const Instr& ins) {
     case Op::Ceil: return op_round(in(0), true);
     case Op::Mod1: return op_mod1(in(0));
     case Op::Dz: return op_dz(in(0));
-    case Op::Pow:
-    case Op::Sqrt:
-    case Op::Log: return call_core(ins.op, 0, {&in(0), &in(ir::arity(ins.op) > 1 ? 1 : 0)}, true);
+    case Op::Sqrt: return fast_kernels_ ? op_sqrt(in(0)) : call_core(ins.op, 0, {&in(0)}, true);
     case Op::Sin:
     case Op::Cos:
-    case Op::Tan:
-    case Op::Exp: return call_core(ins.op, 0, {&in(0)}, in(0).f.maybe_empty);
+        if (fast_kernels_) return op_sincos(in(0), ins.op == Op::Cos);
+        return call_core(ins.op, 0, {&in(0)}, in(0).f.maybe_empty);
+    case Op::Pow:
+    case Op::Log: return call_core(ins.op, 0, {&in(0), &in(ir::arity(ins.op) > 1 ? 1 : 0)}, true);
+    case Op::Exp:
+        if (fast_kernels_) return op_exp(in(0));
+        return call_core(ins.op, 0, {&in(0)}, in(0).f.maybe_empty);
+    case Op::Tan: return call_core(ins.op, 0, {&in(0)}, in(0).f.maybe_empty);
     case Op::Atan2: return call_core(ins.op, 0, {&in(0), &in(1)}, in(0).f.maybe_empty || in(1).f.maybe_empty);
     case Op::External: return call_external(ins.imm, in(0), in(1), in(2));
     case Op::Lt:

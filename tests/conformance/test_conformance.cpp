@@ -7,6 +7,7 @@
 #include "runtime/rss.hpp"
 
 #include <cfenv>
+#include <cstdlib>
 #include <thread>
 
 using namespace frac;
@@ -216,13 +217,12 @@ TEMPLATE_TEST_CASE("clones evaluate on several threads", "[conformance]", Interp
 
 namespace {
 
-// The three engines on the same random boxes and points, one by one and in batches: returns a
-// description of the first difference in bits, empty when there is none. Boxes with an empty coordinate
-// are left out: compiled models give them the empty image (docs/c-abi.md), the others evaluate on them.
-std::string engines_differ(const ir::Tape& t, const std::vector<Interval>& range, std::uint64_t seed,
-                           std::size_t count, const ir::EvalOptions& o = {}) {
-    std::unique_ptr<ir::Evaluator> e[3] = {InterpEngine::make(t, o), JitEngine::make(t, o),
-                                           AotEngine::make(t, o)};
+// Engines e[1 .. engines) against e[0] on the same random boxes and points, one by one and in batches:
+// returns a description of the first difference in bits, empty when there is none. Boxes with an empty
+// coordinate are left out: compiled models give them the empty image (docs/c-abi.md), the others evaluate on
+// them.
+std::string differ_from_first(const std::unique_ptr<ir::Evaluator>* e, int engines, const ir::Tape& t,
+                              const std::vector<Interval>& range, std::uint64_t seed, std::size_t count) {
     const auto d = static_cast<std::size_t>(t.inputs);
     BoxMaker mk(seed);
     std::vector<Interval> boxes;
@@ -233,7 +233,7 @@ std::string engines_differ(const ir::Tape& t, const std::vector<Interval>& range
     }
     std::vector<Interval> batch[3];
     std::vector<double> pbatch[3];
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < engines; ++k) {
         batch[k].resize(count);
         pbatch[k].resize(count);
         e[k]->eval_boxes(boxes.data(), count, batch[k].data());
@@ -244,8 +244,8 @@ std::string engines_differ(const ir::Tape& t, const std::vector<Interval>& range
         const double* p = points.data() + d * n;
         const Interval ri = e[0]->eval_box(b);
         const double pi = e[0]->eval_point(p);
-        for (int k = 1; k < 3; ++k) {
-            const std::string who = e[k]->engine() + " (interp ";
+        for (int k = 1; k < engines; ++k) {
+            const std::string who = e[k]->engine() + " (" + e[0]->engine() + " ";
             if (!same(e[k]->eval_box(b), ri))
                 return "box " + hex_box(b, t.inputs) + ": " + who + hex(ri) + ") " + hex(e[k]->eval_box(b));
             if (!same(batch[k][n], ri)) return "batch box " + std::to_string(n) + ": " + who + hex(ri) + ")";
@@ -256,6 +256,21 @@ std::string engines_differ(const ir::Tape& t, const std::vector<Interval>& range
         }
     }
     return "";
+}
+
+// The interpreter against the JIT and a compiled model built with the numeric core's calls in place of
+// the inline sin, cos and exp kernels (FRAC_JIT_EXACT_CALLS=1: the interpreter's bits); then the JIT
+// against a compiled model with the inline kernels (the same generated code).
+std::string engines_differ(const ir::Tape& t, const std::vector<Interval>& range, std::uint64_t seed,
+                           std::size_t count, const ir::EvalOptions& o = {}) {
+    setenv("FRAC_JIT_EXACT_CALLS", "1", 1);
+    std::unique_ptr<ir::Evaluator> exact[3] = {InterpEngine::make(t, o), JitEngine::make(t, o),
+                                               AotEngine::make(t, o)};
+    unsetenv("FRAC_JIT_EXACT_CALLS");
+    const std::string differ = differ_from_first(exact, 3, t, range, seed, count);
+    if (!differ.empty()) return differ;
+    std::unique_ptr<ir::Evaluator> inline_kernels[2] = {JitEngine::make(t, o), AotEngine::make(t, o)};
+    return differ_from_first(inline_kernels, 2, t, range, seed, count);
 }
 
 } // namespace

@@ -13,6 +13,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <memory>
 #include <random>
 #include <string>
@@ -38,6 +39,15 @@ struct JitEngine {
         return jit::make_jit(t, o);
     }
 };
+// The JIT with the numeric core's calls in place of the inline sin, cos and exp kernels
+// (FRAC_JIT_EXACT_CALLS=1): the interpreter's bits, for the checks that compare engines bit for bit.
+inline std::unique_ptr<ir::Evaluator> make_jit_exact_calls(const ir::Tape& t, const ir::EvalOptions& o = {},
+                                                           const jit::JitConfig& config = {}) {
+    setenv("FRAC_JIT_EXACT_CALLS", "1", 1);
+    auto e = jit::make_jit(t, o, config);
+    unsetenv("FRAC_JIT_EXACT_CALLS");
+    return e;
+}
 // The tape compiled as `frac compile -o model.so` compiles it, loaded with dlopen (backend/llvm/aot.hpp).
 struct AotEngine {
     static constexpr const char* name = "aot";

@@ -50,9 +50,13 @@ TEST_CASE("identical RSS covers for every stdlib shape", "[llvm][rss]") {
             INFO(why);
             CHECK(ri.boundary == rj.boundary);
             CHECK(ri.evaluated == rj.evaluated);
-            CHECK(in->stats.series_terms == jt->stats.series_terms);
-            CHECK(in->stats.series_capped == jt->stats.series_capped);
             CHECK(in->stats.calls == jt->stats.calls);
+            // Term counts: the inline sin/cos/exp kernels enclose a few ulps more loosely and adaptive
+            // truncation looks at widths, so they are compared with the core's calls.
+            auto jx = make_jit_exact_calls(m.tapes[i]);
+            rt::subdivide(*jx, s.box, o);
+            CHECK(in->stats.series_terms == jx->stats.series_terms);
+            CHECK(in->stats.series_capped == jx->stats.series_capped);
         }
     }
 }

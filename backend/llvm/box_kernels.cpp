@@ -1,0 +1,153 @@
+// Interval kernels of box code computed inline in vector form instead of calling the numeric core lane
+// by lane (see box_gen.hpp): sqrt with directed rounding, sin and cos by range reduction and
+// polynomials with a proven error bound, exp likewise. Lanes a kernel cannot handle call the core.
+#include "backend/llvm/box_gen.hpp"
+
+#include <iterator>
+
+namespace frac::jit::box {
+
+SlotState BoxGen::op_sqrt(const SlotState& a) {
+    // numeric/interval.cpp: empty when a is empty or a.hi < 0, else [RD(sqrt(max(a.lo, 0))), RU(sqrt(a.hi))].
+    Value* e = lor(empty_of(a), lt(a.v.hi, cst(0.0)));
+    const IV r{sqrt_down(std_max(a.v.lo, cst(0.0))), sqrt_up(a.v.hi)};
+    return result(guard(e, r, empty()), true);
+}
+
+namespace {
+
+// Fast lanes have |x| <= trig_fast_limit at both ends (and the other lanes call the core). Then
+// k = round(x * 2/pi) has |k| < 2^30, and the reduction below is exact up to the terms of the bound.
+constexpr double trig_fast_limit = 0x1p30;
+
+// pi/2 = C1 + C2 + C3 with C1 = RN(pi/2), C2 = RN(pi/2 - C1), |C3| < 2^-109 (C3 = -1.4974e-33).
+constexpr double half_pi_1 = 0x1.921fb54442d18p+0;
+constexpr double half_pi_2 = 0x1.1a62633145c07p-54;
+constexpr double two_over_pi_lo = 0x1.45f306dc9c882p-1; // < 2/pi
+constexpr double two_over_pi_hi = 0x1.45f306dc9c883p-1; // > 2/pi
+
+// Taylor coefficients RN(+-1/n!): sin r = r + r z S(z), cos r = 1 + z C(z), z = r^2, highest first.
+constexpr double sin_coeffs[] = {0x1.952c77030ad4ap-49,  -0x1.ae7f3e733b81fp-41, 0x1.6124613a86d09p-33,
+                                 -0x1.ae64567f544e4p-26, 0x1.71de3a556c734p-19,  -0x1.a01a01a01a01ap-13,
+                                 0x1.1111111111111p-7,   -0x1.5555555555555p-3}; // 1/17! .. -1/3!
+constexpr double cos_coeffs[] = {-0x1.6827863b97d97p-53, 0x1.ae7f3e733b81fp-45,  -0x1.93974a8c07c9dp-37,
+                                 0x1.1eed8eff8d898p-29,  -0x1.27e4fb7789f5cp-22, 0x1.a01a01a01a01ap-16,
+                                 -0x1.6c16c16c16c17p-10, 0x1.5555555555555p-5,   -0x1p-1}; // -1/18! .. -1/2!
+
+// The error bound of an endpoint value v (docs/design.md, "Vector interval kernels"): |v - f(x)| <=
+// rel_bound |v| + |k| abs_per_k + abs_floor.
+constexpr double rel_bound = 0x1p-48;
+constexpr double abs_per_k = 0x1p-100;
+constexpr double abs_floor = 0x1p-1060;
+
+// exp: fast lanes have -700 <= lo <= hi <= 700, so every value and 2^k are normal doubles.
+constexpr double exp_fast_limit = 700;
+// ln 2 = L1 + L2 + L3, L1 = RN(ln 2), L2 = RN(ln 2 - L1), |L3| < 2^-110.
+constexpr double ln2_1 = 0x1.62e42fefa39efp-1;
+constexpr double ln2_2 = 0x1.abc9e3b39803fp-56;
+constexpr double inv_ln2 = 0x1.71547652b82fep+0;
+// Taylor coefficients RN(1/n!), n = 14 .. 0.
+constexpr double exp_coeffs[] = {0x1.93974a8c07c9dp-37,
+                                 0x1.6124613a86d09p-33,
+                                 0x1.1eed8eff8d898p-29,
+                                 0x1.ae64567f544e4p-26,
+                                 0x1.27e4fb7789f5cp-22,
+                                 0x1.71de3a556c734p-19,
+                                 0x1.a01a01a01a01ap-16,
+                                 0x1.a01a01a01a01ap-13,
+                                 0x1.6c16c16c16c17p-10,
+                                 0x1.1111111111111p-7,
+                                 0x1.5555555555555p-5,
+                                 0x1.5555555555555p-3,
+                                 0x1p-1,
+                                 0x1p+0,
+                                 0x1p+0};
+// |v - exp(x)| <= exp_rel_bound v (docs/design.md, "Vector interval kernels").
+constexpr double exp_rel_bound = 0x1p-46;
+
+} // namespace
+
+Value* BoxGen::exp_value(Value* x) {
+    // k = an integer near x / ln 2; r = x - k ln 2 with |r| < 0.347; exp(x) = 2^k exp(r).
+    Value* k = floor(add(mul(x, cst(inv_ln2)), cst(0.5)));
+    Value* nk = neg(k);
+    Value* r = fma(nk, cst(ln2_2), fma(nk, cst(ln2_1), x)); // the inner fma is exact
+    Value* p = cst(exp_coeffs[0]);
+    for (std::size_t i = 1; i < std::size(exp_coeffs); ++i) p = fma(p, r, cst(exp_coeffs[i]));
+    // 2^k from its bits (|k| <= 1010: a normal double); the product is exact.
+    Value* bits =
+        b_.CreateShl(b_.CreateAdd(b_.CreateFPToSI(k, vi64_), llvm::ConstantInt::get(vi64_, 1023)), 52);
+    return mul(p, b_.CreateBitCast(bits, vt_));
+}
+
+SlotState BoxGen::op_exp(const SlotState& a) {
+    const IV& x = a.v;
+    Value* fast = land(le(x.lo, x.hi), land(ge(x.lo, cst(-exp_fast_limit)), le(x.hi, cst(exp_fast_limit))));
+    // exp is increasing: the lower bound at lo, the upper one at hi.
+    Value* at_lo = exp_value(x.lo);
+    Value* at_hi = exp_value(x.hi);
+    // exp 0 = 1 is exact (r = 0, the polynomial gives 1), and kept thin as in sincos_point.
+    auto err = [&](Value* at, Value* arg) {
+        return sel(eq(arg, cst(0.0)), cst(0.0), mul(at, cst(exp_rel_bound)));
+    };
+    const IV r{std_max(sub_down(at_lo, err(at_lo, x.lo)), cst(0.0)), add(at_hi, err(at_hi, x.hi))};
+    return result(with_fallback(fast, r, Op::Exp, {&a}), a.f.maybe_empty);
+}
+
+IV BoxGen::sincos_point(Value* x, int shift) {
+    // k = an integer near x / (pi/2); r = x - k pi/2 with |r| < 0.786.
+    Value* k = floor(add(mul(x, cst(two_over_pi_hi)), cst(0.5)));
+    Value* nk = neg(k);
+    Value* r1 = fma(nk, cst(half_pi_1), x); // exact: see the bound's derivation
+    Value* r = fma(nk, cst(half_pi_2), r1);
+    Value* z = mul(r, r);
+    Value* s = cst(sin_coeffs[0]);
+    for (std::size_t i = 1; i < std::size(sin_coeffs); ++i) s = fma(s, z, cst(sin_coeffs[i]));
+    s = fma(mul(r, z), s, r);
+    Value* c = cst(cos_coeffs[0]);
+    for (std::size_t i = 1; i < std::size(cos_coeffs); ++i) c = fma(c, z, cst(cos_coeffs[i]));
+    c = fma(z, c, cst(1.0));
+    // The quadrant q = k + shift mod 4 (exact in doubles): f(x) = s, c, -s, -c for q = 0, 1, 2, 3.
+    Value* q = add(k, cst(static_cast<double>(shift)));
+    q = sub(q, mul(cst(4.0), floor(mul(q, cst(0.25)))));
+    Value* odd = b_.CreateOr(eq(q, cst(1.0)), eq(q, cst(3.0)));
+    Value* v = sel(odd, c, s);
+    v = sel(ge(q, cst(2.0)), neg(v), v);
+    Value* err = add(add(mul(fabs(v), cst(rel_bound)), mul(fabs(k), cst(abs_per_k))), cst(abs_floor));
+    // At x = 0 the values 0 and 1 are exact (r = z = 0); elsewhere sin x and cos x are transcendental
+    // (Lindemann), never a double. Keeping sin 0 and cos 0 thin keeps what depends on thinness (pow's
+    // integer exponents, equality) as the interpreter has it.
+    err = sel(eq(x, cst(0.0)), cst(0.0), err);
+    return {sub_down(v, err), add(v, err)};
+}
+
+SlotState BoxGen::op_sincos(const SlotState& a, bool is_cos) {
+    const IV& x = a.v;
+    // Non-empty lanes with both ends within the limit (NaN compares false).
+    Value* fast = land(le(x.lo, x.hi),
+                       land(le(fabs(x.lo), cst(trig_fast_limit)), le(fabs(x.hi), cst(trig_fast_limit))));
+    // As numeric/interval.cpp: t encloses x / (pi/2); sin has its maxima at t = 1 and its minima at
+    // t = 3 (mod 4), cos at 0 and 2; a t-range of 4 or more is a whole period.
+    Value* t_lo = mul_down(x.lo, sel(ge(x.lo, cst(0.0)), cst(two_over_pi_lo), cst(two_over_pi_hi)));
+    Value* t_hi = mul(x.hi, sel(ge(x.hi, cst(0.0)), cst(two_over_pi_hi), cst(two_over_pi_lo)));
+    Value* whole = ge(sub(t_hi, t_lo), cst(4.0));
+    // Whether [t_lo, t_hi] holds an integer congruent to m mod 4 (all integers here are exact).
+    Value* n = ceil(t_lo);
+    Value* n_mod4 = sub(n, mul(cst(4.0), floor(mul(n, cst(0.25)))));
+    auto hits = [&](double m) {
+        Value* d = sub(cst(m), n_mod4);
+        d = sel(lt(d, cst(0.0)), add(d, cst(4.0)), d);
+        return le(add(n, d), t_hi);
+    };
+    const double max_at = is_cos ? 0.0 : 1.0;
+    const int shift = is_cos ? 1 : 0;
+    const IV at_lo = sincos_point(x.lo, shift);
+    const IV at_hi = sincos_point(x.hi, shift);
+    Value* lo = std_max(std_min(at_lo.lo, at_hi.lo), cst(-1.0));
+    Value* hi = std_min(std_max(at_lo.hi, at_hi.hi), cst(1.0));
+    lo = sel(b_.CreateOr(whole, hits(max_at + 2.0)), cst(-1.0), lo);
+    hi = sel(b_.CreateOr(whole, hits(max_at)), cst(1.0), hi);
+    return result(with_fallback(fast, {lo, hi}, is_cos ? Op::Cos : Op::Sin, {&a}), a.f.maybe_empty);
+}
+
+} // namespace frac::jit::box
