@@ -1,5 +1,6 @@
 // frac: the command-line tool. Thin: it wires the frontend, the engines and the runtime together.
 #include "cli/commands.hpp"
+#include "cli/fit_curve.hpp"
 #include "frontend/suggest.hpp"
 #include "runtime/rss.hpp"
 
@@ -234,6 +235,10 @@ int run(int argc, char** argv) {
     analyze->add_option("name", analyze_name, "ifs or cifs name")->required();
     add_set(analyze);
 
+    cli::FitCurveOptions fit_options;
+    auto* fit = app.add_subcommand("fit", "fit a fractal model to data and write it as a .frac model");
+    cli::add_fit_curve_options(fit, fit_options);
+
     std::vector<std::string> files;
     auto* test = app.add_subcommand("test", "run the test blocks of model files");
     test->add_option("files", files, "model files")->required();
@@ -324,6 +329,7 @@ int run(int argc, char** argv) {
         if (*chaos) return cli::run_chaos(file, chaos_options);
         if (*analyze) return cli::run_analyze(file, analyze_name);
         if (*solve) return cli::run_solve(file, solve_name);
+        if (*fit) return cli::run_fit_curve(fit_options);
         if (*mesh) return cli::run_mesh(file, mesh_options, engine);
         if (*test) return cli::run_tests(files, false, engine);
         if (*compile) return cli::run_compile(file, compile_options);
