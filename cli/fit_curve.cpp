@@ -67,6 +67,11 @@ int generate(const FitCurveOptions& o) {
     return 0;
 }
 
+// A parameter as printed: rounding noise around 0 shows as 0, not -0.0000.
+double shown(double v) {
+    return std::abs(v) < 5e-5 ? 0.0 : v;
+}
+
 void report_hough(const rt::fit::HoughResult& r) {
     std::cout << fmt::format("hough: {} maps, {} valid; steps a {:.4g} b {:.4g} c {:.4g} d {:.4g} e {:.4g}\n",
                              r.maps, r.valid, r.steps.a, r.steps.b, r.steps.c, r.steps.d, r.steps.e);
@@ -180,15 +185,16 @@ int run_fit_curve(const FitCurveOptions& o) {
     for (std::size_t i = 0; i < f.pieces.size(); ++i) {
         const auto& p = f.pieces[i];
         std::cout << fmt::format("  T{}: [{:.4f}, {:.4f}] -> [{:.4f}, {:.4f}]  a {:.4f}  d {:.4f}", i + 1,
-                                 p.alpha, p.beta, p.lo, p.hi, p.map.a, p.map.d);
+                                 shown(p.alpha), shown(p.beta), shown(p.lo), shown(p.hi), shown(p.map.a),
+                                 shown(p.map.d));
         if (data.curve())
             std::cout << fmt::format(
                 "  b ({:.4f}, {:.4f})  C [[{:.4f}, {:.4f}], [{:.4f}, {:.4f}]]  e ({:.4f}, {:.4f})\n",
-                p.map.b[0], p.map.b[1], p.map.c[0][0], p.map.c[0][1], p.map.c[1][0], p.map.c[1][1],
-                p.map.e[0], p.map.e[1]);
+                shown(p.map.b[0]), shown(p.map.b[1]), shown(p.map.c[0][0]), shown(p.map.c[0][1]),
+                shown(p.map.c[1][0]), shown(p.map.c[1][1]), shown(p.map.e[0]), shown(p.map.e[1]));
         else
-            std::cout << fmt::format("  b {:.4f}  c {:.4f}  e {:.4f}\n", p.map.b[0], p.map.c[0][0],
-                                     p.map.e[0]);
+            std::cout << fmt::format("  b {:.4f}  c {:.4f}  e {:.4f}\n", shown(p.map.b[0]),
+                                     shown(p.map.c[0][0]), shown(p.map.e[0]));
     }
     if (o.output.empty()) return 0;
     if (!f.every_domain_whole() && !f.domains_are_unions_of_ranges(1e-9 * (f.t1 - f.t0)))

@@ -336,6 +336,17 @@ FractalFunction fif_from_clusters(const HoughResult& result, const Samples& s, s
     const std::string why = make_consistent(f, tolerance);
     if (!why.empty())
         throw std::runtime_error(fmt::format("the {} most popular maps do not make a FIF: {}", count, why));
+    // The joins between ranges are known to quantisation error: each moves to the nearest sample.
+    for (std::size_t i = 0; i + 1 < f.pieces.size(); ++i) {
+        const double join = f.pieces[i].hi;
+        const auto it = std::lower_bound(s.t.begin(), s.t.end(), join);
+        double nearest = it == s.t.end() ? s.t.back() : *it;
+        if (it != s.t.begin() && join - *std::prev(it) < nearest - join) nearest = *std::prev(it);
+        if (nearest > f.pieces[i].lo && nearest < f.pieces[i + 1].hi) {
+            set_range(f.pieces[i], f.pieces[i].lo, nearest);
+            set_range(f.pieces[i + 1], nearest, f.pieces[i + 1].hi);
+        }
+    }
     return f;
 }
 

@@ -72,6 +72,14 @@ bool FractalFunction::domains_are_unions_of_ranges(double tolerance) const {
                        [&](const Piece& p) { return on_boundary(p.alpha) && on_boundary(p.beta); });
 }
 
+void set_range(Piece& p, double lo, double hi) {
+    p.lo = lo;
+    p.hi = hi;
+    const double a = (hi - lo) / (p.beta - p.alpha);
+    p.map.a = p.map.a < 0 ? -a : a;
+    p.map.d = p.map.a < 0 ? hi - p.map.a * p.alpha : lo - p.map.a * p.alpha;
+}
+
 std::string make_consistent(FractalFunction& f, double tolerance) {
     if (f.pieces.empty()) return "no maps";
     for (Piece& p : f.pieces) {
@@ -95,12 +103,8 @@ std::string make_consistent(FractalFunction& f, double tolerance) {
                            f.pieces.front().lo, f.pieces.back().hi, f.t0, f.t1);
     for (std::size_t i = 0; i < f.pieces.size(); ++i) {
         Piece& p = f.pieces[i];
-        p.lo = cut[i];
-        p.hi = cut[i + 1];
-        if (!(p.hi > p.lo) || !(p.beta > p.alpha)) return "a map with an empty range or domain";
-        const double a = (p.hi - p.lo) / (p.beta - p.alpha);
-        p.map.a = p.map.a < 0 ? -a : a;
-        p.map.d = p.map.a < 0 ? p.hi - p.map.a * p.alpha : p.lo - p.map.a * p.alpha;
+        if (!(cut[i + 1] > cut[i]) || !(p.beta > p.alpha)) return "a map with an empty range or domain";
+        set_range(p, cut[i], cut[i + 1]);
         if (!(std::abs(p.map.a) < 1))
             return fmt::format("the map onto [{:.4g}, {:.4g}] does not contract in t (|a| = {:.4g})", p.lo,
                                p.hi, std::abs(p.map.a));
@@ -172,9 +176,7 @@ void quantize8(FractalFunction& f, const Samples& data) {
             p.alpha = quantize(p.alpha, f.t0, f.t1);
             p.beta = quantize(p.beta, f.t0, f.t1);
         }
-        const double a = (p.hi - p.lo) / (p.beta - p.alpha);
-        p.map.a = p.map.a < 0 ? -a : a;
-        p.map.d = p.map.a < 0 ? p.hi - p.map.a * p.alpha : p.lo - p.map.a * p.alpha;
+        set_range(p, p.lo, p.hi);
         for (int k = 0; k < (f.curve ? 2 : 1); ++k) {
             p.map.b[k] = quantize(p.map.b[k], -b_max, b_max);
             p.map.e[k] = quantize(p.map.e[k], -e_max, e_max);

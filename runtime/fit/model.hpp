@@ -52,6 +52,9 @@ struct FractalFunction {
     bool domains_are_unions_of_ranges(double tolerance) const;
 };
 
+// Makes the piece map its domain onto [lo, hi], keeping its orientation (the sign of a).
+void set_range(Piece& piece, double lo, double hi);
+
 // Checks that the ranges of the pieces tile [t0, t1] (within `tolerance`, then made exact) and that each
 // shear contracts (|a| < 1, vertical norm < 1); returns "" or what is wrong.
 std::string make_consistent(FractalFunction& f, double tolerance);
