@@ -128,7 +128,12 @@ double max_abs(const std::vector<double>& v) {
     return m;
 }
 
+// v rounded to 8 bits over [lo, hi]; a symmetric range has the levels -127..127, so 0 is exact.
 double quantize(double v, double lo, double hi) {
+    if (lo == -hi) {
+        const double step = hi / 127;
+        return std::clamp(std::round(v / step), -127.0, 127.0) * step;
+    }
     const double step = (hi - lo) / 255;
     return lo + std::clamp(std::round((v - lo) / step), 0.0, 255.0) * step;
 }
