@@ -157,7 +157,7 @@ int run_fit_curve(const FitCurveOptions& o) {
             std::cout << fmt::format(
                 "the FIF of the top {} clusters: max error {:.4g}, mean squared error {:.4g}\n", maps,
                 crude.max_error, crude.mse);
-            rt::fit::refit_least_squares(f, data, ls);
+            rt::fit::refit_joins(f, data, ls, rt::fit::join_tolerance(r, data));
         } else {
             f = rt::fit::fit_least_squares(data, ls);
         }

@@ -322,6 +322,11 @@ HoughResult hough_recover(const Samples& s, const HoughOptions& o) {
     return result;
 }
 
+double join_tolerance(const HoughResult& result, const Samples& s) {
+    // A map's range is known to a few steps of d (and of a, times the interval).
+    return 2 * result.steps.d + result.steps.a * (s.t.back() - s.t.front());
+}
+
 FractalFunction fif_from_clusters(const HoughResult& result, const Samples& s, std::size_t count) {
     if (result.clusters.size() < count)
         throw std::runtime_error(
@@ -331,22 +336,9 @@ FractalFunction fif_from_clusters(const HoughResult& result, const Samples& s, s
     f.t0 = s.t.front();
     f.t1 = s.t.back();
     for (std::size_t i = 0; i < count; ++i) f.pieces.push_back({result.clusters[i].map, f.t0, f.t1, 0, 0});
-    // A map's range is known to a few steps of d (and of a, times the interval).
-    const double tolerance = 2 * result.steps.d + result.steps.a * (f.t1 - f.t0);
-    const std::string why = make_consistent(f, tolerance);
+    const std::string why = make_consistent(f, join_tolerance(result, s));
     if (!why.empty())
         throw std::runtime_error(fmt::format("the {} most popular maps do not make a FIF: {}", count, why));
-    // The joins between ranges are known to quantisation error: each moves to the nearest sample.
-    for (std::size_t i = 0; i + 1 < f.pieces.size(); ++i) {
-        const double join = f.pieces[i].hi;
-        const auto it = std::lower_bound(s.t.begin(), s.t.end(), join);
-        double nearest = it == s.t.end() ? s.t.back() : *it;
-        if (it != s.t.begin() && join - *std::prev(it) < nearest - join) nearest = *std::prev(it);
-        if (nearest > f.pieces[i].lo && nearest < f.pieces[i + 1].hi) {
-            set_range(f.pieces[i], f.pieces[i].lo, nearest);
-            set_range(f.pieces[i + 1], nearest, f.pieces[i + 1].hi);
-        }
-    }
     return f;
 }
 

@@ -52,7 +52,9 @@ struct HoughResult {
 HoughResult hough_recover(const Samples& data, const HoughOptions& options);
 
 // The FIF made of the `count` most popular clusters: their ranges must tile the data's interval within
-// `tolerance` of t (then they are joined exactly). Throws std::runtime_error saying why not.
+// `join_tolerance` (then they are joined exactly, at midpoints). Throws std::runtime_error saying why not.
 FractalFunction fif_from_clusters(const HoughResult& result, const Samples& data, std::size_t count);
+// How far a join between the ranges of recovered maps may be from the true one: quantisation of d and a.
+double join_tolerance(const HoughResult& result, const Samples& data);
 
 } // namespace frac::rt::fit

@@ -169,6 +169,37 @@ void refit_least_squares(FractalFunction& f, const Samples& s, const LeastSquare
     }
 }
 
+void refit_joins(FractalFunction& f, const Samples& s, const LeastSquaresOptions& o, double window) {
+    const Fitter fitter{s, o};
+    auto collage = [&](const Piece& p) {
+        const auto [first, last] = fitter.samples_in(p.lo, p.hi);
+        return fitter.best(p.lo, p.hi, first, last, {{p.alpha, p.beta}}, p.map.a > 0 ? 0 : 1);
+    };
+    for (std::size_t i = 0; i + 1 < f.pieces.size(); ++i) {
+        Piece& left = f.pieces[i];
+        Piece& right = f.pieces[i + 1];
+        const double join = left.hi;
+        Match best_left, best_right;
+        double best = infinity;
+        for (double t : s.t) {
+            if (std::abs(t - join) > window || !(t > left.lo) || !(t < right.hi)) continue;
+            Piece l = left, r = right;
+            set_range(l, l.lo, t);
+            set_range(r, t, r.hi);
+            const Match ml = collage(l), mr = collage(r);
+            if (ml.sse + mr.sse < best) {
+                best = ml.sse + mr.sse;
+                best_left = ml;
+                best_right = mr;
+            }
+        }
+        if (std::isfinite(best)) {
+            left = best_left.piece;
+            right = best_right.piece;
+        }
+    }
+}
+
 FractalFunction fit_least_squares(const Samples& s, const LeastSquaresOptions& o) {
     using clock = std::chrono::steady_clock;
     const auto started = clock::now();

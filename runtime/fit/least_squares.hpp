@@ -37,4 +37,9 @@ FractalFunction fit_least_squares(const Samples& data, const LeastSquaresOptions
 // samples keeps its map.
 void refit_least_squares(FractalFunction& f, const Samples& data, const LeastSquaresOptions& options);
 
+// Moves each join between consecutive ranges to the sample within `window` of it where the two maps,
+// refitted by least squares, have the least collage error (the joins of recovered maps are known only to
+// quantisation error), and refits the two maps there.
+void refit_joins(FractalFunction& f, const Samples& data, const LeastSquaresOptions& options, double window);
+
 } // namespace frac::rt::fit

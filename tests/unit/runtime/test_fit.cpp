@@ -49,10 +49,10 @@ void require_table1_recovered(int level, std::size_t points) {
         CHECK_FALSE(matches(r.clusters[i].map, t1, r.steps, 2));
         CHECK_FALSE(matches(r.clusters[i].map, t2, r.steps, 2));
     }
-    // The FIF of the two clusters, refined by least squares, is close to the data.
+    // The FIF of the two clusters, its join and maps refined by least squares, is close to the data.
     FractalFunction f = fif_from_clusters(r, s, 2);
-    refit_least_squares(f, s, LeastSquaresOptions{});
-    CHECK(measure(f, s).max_error < 0.1);
+    refit_joins(f, s, LeastSquaresOptions{}, join_tolerance(r, s));
+    CHECK(measure(f, s).max_error < 0.01);
 }
 
 } // namespace
