@@ -103,6 +103,7 @@ struct FitSurfaceOptions {
     int controls = 4, depth = 0, iterations = 100, bits = 16; // depth 0: chosen from the data's size
     double seconds = 0, target_psnr = 0;
 };
+// The surface fit's own options (the data file, -o, --method, --quantize and --name are the command's).
 void add_fit_surface_options(CLI::App* fit, FitSurfaceOptions& options);
 // frac fit DATA -o MODEL.frac --method lm: a projected IFS fitted to a height grid or a grey image.
 int run_fit_surface(const FitSurfaceOptions& options);

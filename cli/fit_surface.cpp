@@ -13,15 +13,6 @@
 namespace frac::cli {
 
 void add_fit_surface_options(CLI::App* fit, FitSurfaceOptions& o) {
-    fit->add_option(
-           "data", o.data,
-           "data: a CSV grid of heights (one row a line), a grey 8-bit PNG (an image) or a grey 16-bit "
-           "PNG (heights)")
-        ->required();
-    fit->add_option("-o,--output", o.output, "the model written, MODEL.frac")->required();
-    fit->add_option("--method", o.method, "lm: Levenberg-Marquardt fitting of a projected IFS quad patch")
-        ->check(CLI::IsMember({"lm"}))
-        ->capture_default_str();
     fit->add_option("--patches", o.patches, "sub-patches per side, NxN (the patch IFS has N^2 operators)")
         ->capture_default_str();
     fit->add_option("--controls", o.controls, "control points per side of the control grid")
@@ -41,10 +32,6 @@ void add_fit_surface_options(CLI::App* fit, FitSurfaceOptions& o) {
     fit->add_option("--target-psnr", o.target_psnr,
                     "stop once the PSNR reaches this many dB; a fit that does not reach it writes nothing")
         ->check(CLI::Range(0.0, 400.0));
-    fit->add_option("--quantize", o.bits, "bits per stored parameter (the model size counts them)")
-        ->check(CLI::Range(2, 32))
-        ->capture_default_str();
-    fit->add_option("--name", o.name, "name of the bcifs written")->capture_default_str();
 }
 
 namespace {

@@ -1,5 +1,6 @@
 // frac: the command-line tool. Thin: it wires the frontend, the engines and the runtime together.
 #include "cli/commands.hpp"
+#include "cli/fit_curve.hpp"
 #include "frontend/suggest.hpp"
 #include "runtime/rss.hpp"
 
@@ -281,11 +282,32 @@ int run(int argc, char** argv) {
         ->capture_default_str();
     add_set(compile);
 
-    cli::FitSurfaceOptions fit_options;
+    // frac fit: curves and functions (cli/fit_curve.cpp: hough, pfif, rfif) and surfaces and images
+    // (cli/fit_surface.cpp: lm) share the data file, the output, the method, the quantisation, the name.
+    cli::FitCurveOptions fit_curve;
+    cli::FitSurfaceOptions fit_surface;
+    std::string fit_data, fit_output, fit_method, fit_name;
+    int fit_quantize = 0;
     auto* fit =
-        app.add_subcommand("fit", "fit a fractal model to data: a projected IFS to a height grid or a "
-                                  "grey image (--method lm)");
-    cli::add_fit_surface_options(fit, fit_options);
+        app.add_subcommand("fit", "fit a fractal model to data and write it as a .frac model: a FIF "
+                                  "to a curve or function, a projected IFS to a height grid or image");
+    fit->add_option("data", fit_data,
+                    "data: a CSV of t,x (a function) or x,y / t,x,y (a curve) rows; a CSV grid of heights, a "
+                    "grey 8-bit PNG (an image) or 16-bit PNG (heights) for --method lm");
+    fit->add_option("-o,--output", fit_output, "the model written (.frac); with --generate, the CSV written");
+    fit->add_option("--method", fit_method,
+                    "hough: the maps of a self-affine function (seed 001 sec. 3.1); pfif or rfif: a "
+                    "least-squares partitioned or recurrent FIF (sec. 3.2); lm: Levenberg-Marquardt fitting "
+                    "of a projected IFS quad patch (seed 003 sec. 4). Default: lm for a .png, else pfif")
+        ->check(CLI::IsMember({"hough", "pfif", "rfif", "lm"}));
+    fit->add_option("--quantize", fit_quantize,
+                    "bits per stored parameter: curves 8 (default: full precision), surfaces 2 to 32 "
+                    "(default 16)");
+    fit->add_option("--name", fit_name,
+                    "the model's name (default: the output's stem for curves, fitted "
+                    "for surfaces)");
+    cli::add_fit_curve_options(fit, fit_curve);
+    cli::add_fit_surface_options(fit, fit_surface);
 
     // `frac help [COMMAND]`: the text of `frac [COMMAND] --help`.
     std::string help_topic;
@@ -344,11 +366,32 @@ int run(int argc, char** argv) {
         if (*chaos) return cli::run_chaos(file, chaos_options);
         if (*analyze) return cli::run_analyze(file, analyze_name);
         if (*solve) return cli::run_solve(file, solve_name);
+
         if (*mesh) return cli::run_mesh(file, mesh_options, engine);
         if (*test) return cli::run_tests(files, false, engine);
         if (*compile) return cli::run_compile(file, compile_options);
         if (*run) return cli::run_tests({file}, true, engine);
-        if (*fit) return cli::run_fit_surface(fit_options);
+        if (*fit) {
+            if (fit_method == "lm" || (fit_method.empty() && cli::ends_with(fit_data, ".png"))) {
+                if (fit_data.empty() || fit_output.empty())
+                    throw cli::UsageError(
+                        "frac fit DATA -o MODEL.frac --method lm: give the data and the output");
+                if (fit_quantize != 0 && (fit_quantize < 2 || fit_quantize > 32))
+                    throw cli::UsageError(
+                        fmt::format("--quantize {}: a surface fit stores 2 to 32 bits", fit_quantize));
+                fit_surface.data = fit_data;
+                fit_surface.output = fit_output;
+                if (fit_quantize != 0) fit_surface.bits = fit_quantize;
+                if (!fit_name.empty()) fit_surface.name = fit_name;
+                return cli::run_fit_surface(fit_surface);
+            }
+            fit_curve.file = fit_data;
+            fit_curve.output = fit_output;
+            if (!fit_method.empty()) fit_curve.method = fit_method;
+            fit_curve.quantize = fit_quantize;
+            fit_curve.name = fit_name;
+            return cli::run_fit_curve(fit_curve);
+        }
     } catch (const cli::UsageError& e) {
         std::cerr << "frac: error: " << e.what() << "\n";
         return front::exit_usage_error;
