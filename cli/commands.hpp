@@ -105,6 +105,9 @@ struct FitSurfaceOptions {
 };
 // The surface fit's own options (the data file, -o, --method, --quantize and --name are the command's).
 void add_fit_surface_options(CLI::App* fit, FitSurfaceOptions& options);
+// Whether `frac fit` without --method takes `path` for a surface: a PNG, or a CSV whose first row has more
+// than 3 fields (a grid of heights; samples of a function or curve have 2 or 3).
+bool is_surface_data(const std::string& path);
 // frac fit DATA -o MODEL.frac --method lm: a projected IFS fitted to a height grid or a grey image.
 int run_fit_surface(const FitSurfaceOptions& options);
 

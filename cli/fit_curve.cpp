@@ -31,7 +31,7 @@ rt::fit::Samples read_samples(const std::string& path, rt::fit::DataKind kind) {
     text << in.rdbuf();
     try {
         return rt::fit::parse_csv(text.str(), kind);
-    } catch (const rt::fit::DataError& e) {
+    } catch (const rt::fit::SamplesError& e) {
         if (e.line == 0) throw DataFileError(fmt::format("{}: error: {}\n", path, e.what()));
         front::SourceManager sources;
         const auto id = sources.add(path, text.str());

@@ -7,7 +7,9 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <iostream>
 
 namespace frac::cli {
@@ -32,6 +34,18 @@ void add_fit_surface_options(CLI::App* fit, FitSurfaceOptions& o) {
     fit->add_option("--target-psnr", o.target_psnr,
                     "stop once the PSNR reaches this many dB; a fit that does not reach it writes nothing")
         ->check(CLI::Range(0.0, 400.0));
+}
+
+bool is_surface_data(const std::string& path) {
+    if (ends_with(path, ".png")) return true;
+    std::ifstream in(path);
+    std::string line;
+    while (std::getline(in, line)) {
+        const auto first = line.find_first_not_of(" \t\r");
+        if (first == std::string::npos || line[first] == '#') continue;
+        return std::count(line.begin(), line.end(), ',') + 1 > 3;
+    }
+    return false;
 }
 
 namespace {

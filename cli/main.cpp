@@ -298,7 +298,9 @@ int run(int argc, char** argv) {
     fit->add_option("--method", fit_method,
                     "hough: the maps of a self-affine function (seed 001 sec. 3.1); pfif or rfif: a "
                     "least-squares partitioned or recurrent FIF (sec. 3.2); lm: Levenberg-Marquardt fitting "
-                    "of a projected IFS quad patch (seed 003 sec. 4). Default: lm for a .png, else pfif")
+                    "of a projected IFS quad patch (seed 003 sec. 4). Default: lm for a PNG or a CSV grid of "
+                    "more than 3 "
+                    "columns, else pfif")
         ->check(CLI::IsMember({"hough", "pfif", "rfif", "lm"}));
     fit->add_option("--quantize", fit_quantize,
                     "bits per stored parameter: curves 8 (default: full precision), surfaces 2 to 32 "
@@ -372,7 +374,7 @@ int run(int argc, char** argv) {
         if (*compile) return cli::run_compile(file, compile_options);
         if (*run) return cli::run_tests({file}, true, engine);
         if (*fit) {
-            if (fit_method == "lm" || (fit_method.empty() && cli::ends_with(fit_data, ".png"))) {
+            if (fit_method == "lm" || (fit_method.empty() && cli::is_surface_data(fit_data))) {
                 if (fit_data.empty() || fit_output.empty())
                     throw cli::UsageError(
                         "frac fit DATA -o MODEL.frac --method lm: give the data and the output");

@@ -45,11 +45,11 @@ double parse_number(const Field& f, std::size_t line) {
     const char* begin = f.text.data();
     if (!f.text.empty() && f.text[0] == '+') ++begin;
     const auto [end, ec] = std::from_chars(begin, f.text.data() + f.text.size(), v);
-    if (f.text.empty()) throw DataError(line, f.column, "an empty field where a number was expected");
+    if (f.text.empty()) throw SamplesError(line, f.column, "an empty field where a number was expected");
     if (ec != std::errc() || end != f.text.data() + f.text.size())
-        throw DataError(line, f.column, fmt::format("'{}' is not a number", f.text));
+        throw SamplesError(line, f.column, fmt::format("'{}' is not a number", f.text));
     if (!std::isfinite(v))
-        throw DataError(line, f.column, fmt::format("'{}' is not a finite number", f.text));
+        throw SamplesError(line, f.column, fmt::format("'{}' is not a finite number", f.text));
     return v;
 }
 
@@ -74,43 +74,43 @@ Samples parse_csv(std::string_view text, DataKind kind) {
             std::string names;
             for (const Field& f : fields) {
                 if (!is_name(f.text))
-                    throw DataError(line_no, f.column,
+                    throw SamplesError(line_no, f.column,
                                     fmt::format("'{}' is not a column name (t, x or y)", f.text));
                 names += std::string(f.text);
             }
             if (names != "tx" && names != "xy" && names != "txy")
-                throw DataError(line_no, 1,
+                throw SamplesError(line_no, 1,
                                 "the header names the columns t,x (a function), x,y or t,x,y (a curve)");
             if (names == "xy") {
                 if (kind == DataKind::function)
-                    throw DataError(line_no, 1,
+                    throw SamplesError(line_no, 1,
                                     "the header names a curve (x,y) but a function (t,x) was asked for");
                 kind = DataKind::curve;
             }
             if (names == "tx" && kind == DataKind::curve)
-                throw DataError(line_no, 1, "the header names a function (t,x) but a curve was asked for");
+                throw SamplesError(line_no, 1, "the header names a function (t,x) but a curve was asked for");
             header_seen = true;
             width = fields.size();
             continue;
         }
         if (width == 0) width = fields.size();
         if (fields.size() != width)
-            throw DataError(line_no, fields.size() > width ? fields[width].column : line.size() + 1,
+            throw SamplesError(line_no, fields.size() > width ? fields[width].column : line.size() + 1,
                             fmt::format("a row of {} fields where the rows have {}", fields.size(), width));
         if (width < 2 || width > 3)
-            throw DataError(
+            throw SamplesError(
                 line_no, 1,
                 fmt::format("a row of {} fields: the data has 2 columns (t,x or x,y) or 3 (t,x,y)", width));
         std::vector<double> v;
         for (const Field& f : fields) v.push_back(parse_number(f, line_no));
         const bool curve = width == 3 || kind == DataKind::curve;
         if (width == 3 && kind == DataKind::function)
-            throw DataError(line_no, 1,
+            throw SamplesError(line_no, 1,
                             "a row of 3 fields (t,x,y: a curve) but a function (t,x) was asked for");
         t_given = width == 3 || !curve;
         if (t_given) {
             if (!s.t.empty() && !(v[0] > s.t.back()))
-                throw DataError(line_no, fields[0].column,
+                throw SamplesError(line_no, fields[0].column,
                                 fmt::format("the parameter {} does not increase (the row before has {})",
                                             fields[0].text, s.t.back()));
             s.t.push_back(v[0]);
@@ -124,7 +124,7 @@ Samples parse_csv(std::string_view text, DataKind kind) {
     }
     const std::size_t n = s.x.size();
     if (n < min_samples)
-        throw DataError(
+        throw SamplesError(
             last_line, 0,
             fmt::format("{} data point{}: a fit needs at least {}", n, n == 1 ? "" : "s", min_samples));
     if (!t_given) // (x, y) points: the parameter runs uniformly over [0, 1]

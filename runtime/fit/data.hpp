@@ -1,5 +1,5 @@
 // Measured data for fitting: a CSV of (t, x) samples of a function, (x, y) points of a curve, or (t, x, y)
-// points of a curve with its parameter. Malformed input is a located DataError (line and column), never a
+// points of a curve with its parameter. Malformed input is a located SamplesError (line and column), never a
 // guess: a row of the wrong width, a field that is not a finite number, a parameter that does not increase,
 // too few points.
 #pragma once
@@ -13,9 +13,9 @@
 namespace frac::rt::fit {
 
 // A user error in the data, at a 1-based line and column of the text (line 0: the file as a whole).
-struct DataError : std::runtime_error {
+struct SamplesError : std::runtime_error {
     std::size_t line, column;
-    DataError(std::size_t l, std::size_t c, const std::string& message)
+    SamplesError(std::size_t l, std::size_t c, const std::string& message)
         : std::runtime_error(message), line(l), column(c) {}
 };
 
@@ -36,7 +36,7 @@ enum class DataKind {
 inline constexpr std::size_t min_samples = 5;
 
 // Parses CSV text: fields separated by commas (or blanks), '#' comments and blank lines ignored, an
-// optional header row of names (t, x, y) first. Throws DataError.
+// optional header row of names (t, x, y) first. Throws SamplesError.
 Samples parse_csv(std::string_view text, DataKind kind = DataKind::automatic);
 
 // The samples as CSV text (a header line, then one row per sample, shortest round-trip decimals).

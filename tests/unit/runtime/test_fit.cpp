@@ -18,7 +18,7 @@ void require_error(const std::string& text, std::size_t line, std::size_t column
     try {
         parse_csv(text);
         FAIL("no error for: " << text);
-    } catch (const DataError& e) {
+    } catch (const SamplesError& e) {
         CHECK(e.line == line);
         CHECK(e.column == column);
         CHECK_THAT(e.what(), Catch::Matchers::Contains(part));
