@@ -75,16 +75,16 @@ Samples parse_csv(std::string_view text, DataKind kind) {
             for (const Field& f : fields) {
                 if (!is_name(f.text))
                     throw SamplesError(line_no, f.column,
-                                    fmt::format("'{}' is not a column name (t, x or y)", f.text));
+                                       fmt::format("'{}' is not a column name (t, x or y)", f.text));
                 names += std::string(f.text);
             }
             if (names != "tx" && names != "xy" && names != "txy")
                 throw SamplesError(line_no, 1,
-                                "the header names the columns t,x (a function), x,y or t,x,y (a curve)");
+                                   "the header names the columns t,x (a function), x,y or t,x,y (a curve)");
             if (names == "xy") {
                 if (kind == DataKind::function)
                     throw SamplesError(line_no, 1,
-                                    "the header names a curve (x,y) but a function (t,x) was asked for");
+                                       "the header names a curve (x,y) but a function (t,x) was asked for");
                 kind = DataKind::curve;
             }
             if (names == "tx" && kind == DataKind::curve)
@@ -95,8 +95,9 @@ Samples parse_csv(std::string_view text, DataKind kind) {
         }
         if (width == 0) width = fields.size();
         if (fields.size() != width)
-            throw SamplesError(line_no, fields.size() > width ? fields[width].column : line.size() + 1,
-                            fmt::format("a row of {} fields where the rows have {}", fields.size(), width));
+            throw SamplesError(
+                line_no, fields.size() > width ? fields[width].column : line.size() + 1,
+                fmt::format("a row of {} fields where the rows have {}", fields.size(), width));
         if (width < 2 || width > 3)
             throw SamplesError(
                 line_no, 1,
@@ -106,13 +107,13 @@ Samples parse_csv(std::string_view text, DataKind kind) {
         const bool curve = width == 3 || kind == DataKind::curve;
         if (width == 3 && kind == DataKind::function)
             throw SamplesError(line_no, 1,
-                            "a row of 3 fields (t,x,y: a curve) but a function (t,x) was asked for");
+                               "a row of 3 fields (t,x,y: a curve) but a function (t,x) was asked for");
         t_given = width == 3 || !curve;
         if (t_given) {
             if (!s.t.empty() && !(v[0] > s.t.back()))
                 throw SamplesError(line_no, fields[0].column,
-                                fmt::format("the parameter {} does not increase (the row before has {})",
-                                            fields[0].text, s.t.back()));
+                                   fmt::format("the parameter {} does not increase (the row before has {})",
+                                               fields[0].text, s.t.back()));
             s.t.push_back(v[0]);
             s.x.push_back(v[1]);
             if (curve) s.y.push_back(v[2]);
