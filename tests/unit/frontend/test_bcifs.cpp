@@ -195,7 +195,7 @@ bcifs tri3 {
     CHECK(a.arcs.size() == 1 + 3 + 9);
 }
 
-TEST_CASE("--seed draws the free entries reproducibly, each seed its own", "[bcifs]") {
+TEST_CASE("free entries drawn from a seed: reproducible, each seed its own", "[bcifs]") {
     const std::string text = R"(
 bcifs edge {
   cell v in bary(1);
