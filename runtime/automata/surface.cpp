@@ -24,6 +24,23 @@ using Index = std::int64_t;
 using num::Matrix;
 using num::Rational;
 
+// The depth in [0, 24], at most 2^26 of what `count()` counts (vertices or triangles), an output in R3
+// or less: the checks every tessellation makes before its work. Returns the output dimension.
+template <class Count>
+int check_tessellation(const ir::Automaton& a, int depth, Count&& count, const char* what) {
+    if (depth < 0 || depth > 24)
+        throw std::invalid_argument(fmt::format("tessellation depth {} is outside [0, 24]", depth));
+    const double n = count();
+    if (n > static_cast<double>(std::uint64_t{1} << 26))
+        throw std::invalid_argument(
+            fmt::format("a tessellation at depth {} would have {:.3g} {} (at most 2^26)", depth, n, what));
+    const int out_dim = a.output_dimension();
+    if (out_dim > 3)
+        throw std::invalid_argument(
+            fmt::format("{} is drawn in R{}: a mesh needs R3 or less", a.name, out_dim));
+    return out_dim;
+}
+
 // The points of depth 2 along each shared side are compared by the layout check.
 constexpr int check_depth = 2;
 
@@ -388,17 +405,13 @@ SurfaceLayout infer_layout(const ir::Automaton& a, const LayoutRequest& request)
 Tessellation tessellate(const ir::Automaton& a, const SurfaceLayout& layout, int depth) {
     const std::vector<std::size_t> states = laid_out_states(a, layout);
     const CellLayout& root = *layout.states[layout.root];
-    if (depth < 0 || depth > 24)
-        throw std::invalid_argument(fmt::format("tessellation depth {} is outside [0, 24]", depth));
-    const double count = (std::pow(static_cast<double>(root.n_s), depth) + 1) *
-                         (root.dimension == 2 ? std::pow(static_cast<double>(root.n_t), depth) + 1 : 1);
-    if (count > static_cast<double>(std::uint64_t{1} << 26))
-        throw std::invalid_argument(fmt::format(
-            "a tessellation at depth {} would have {:.3g} vertices (at most 2^26)", depth, count));
-    const int out_dim = a.output_dimension();
-    if (out_dim > 3)
-        throw std::invalid_argument(
-            fmt::format("{} is drawn in R{}: a mesh needs R3 or less", a.name, out_dim));
+    const int out_dim = check_tessellation(
+        a, depth,
+        [&] {
+            return (std::pow(static_cast<double>(root.n_s), depth) + 1) *
+                   (root.dimension == 2 ? std::pow(static_cast<double>(root.n_t), depth) + 1 : 1);
+        },
+        "vertices");
 
     Tessellation t;
     t.dimension = root.dimension;
@@ -656,16 +669,9 @@ Mesh tessellate_triangle_patch(const ir::Automaton& a, const ir::TrianglePatch& 
     if (patch.state != a.initial)
         throw std::invalid_argument(fmt::format("{}: the triangle patch {} is not the initial state", a.name,
                                                 a.states[patch.state].name));
-    if (depth < 0 || depth > 24)
-        throw std::invalid_argument(fmt::format("tessellation depth {} is outside [0, 24]", depth));
     const double triangles = std::pow(static_cast<double>(patch.n), 2.0 * depth);
-    if (triangles > static_cast<double>(std::uint64_t{1} << 26))
-        throw std::invalid_argument(fmt::format(
-            "a tessellation at depth {} would have {:.3g} triangles (at most 2^26)", depth, triangles));
-    const int out_dim = a.output_dimension();
-    if (out_dim > 3)
-        throw std::invalid_argument(
-            fmt::format("{} is drawn in R{}: a mesh needs R3 or less", a.name, out_dim));
+    const int out_dim = check_tessellation(
+        a, depth, [&] { return triangles; }, "triangles");
     // Global grid points (i, j), i + j <= N, N = n^p, numbered row by row (j), then i.
     const Index side = power(static_cast<std::size_t>(patch.n), depth);
     const auto vertex_index = [&](Index i, Index j) {
