@@ -6,6 +6,7 @@
 #include "runtime/automata/attractor_cover.hpp"
 #include "runtime/automata/chaos.hpp"
 #include "runtime/automata/dimension.hpp"
+#include "runtime/automata/solid.hpp"
 #include "runtime/automata/surface.hpp"
 #include "runtime/automata/tree.hpp"
 #include "runtime/dimension.hpp"
@@ -275,6 +276,18 @@ int mesh_automaton(const front::AutomatonInfo& info, const MeshOptions& o) {
             return report_surface_mesh(info, mesh,
                                        fmt::format("a triangle patch split {} (topology)", patch.n), o);
         }
+    // A solid: volume cells (a bcifs's cube topology) and what places them.
+    if (rt::reaches_volume(a) && o.layout.empty() && o.cells.empty()) {
+        if (ends_with(o.output, ".svg"))
+            throw UsageError(fmt::format("{} is a solid: write it as .stl, .obj or .ply", info.name));
+        const rt::SolidMesh s = runtime_job([&] { return rt::tessellate_solid(a, o.depth); });
+        return report_surface_mesh(
+            info, s.mesh,
+            fmt::format("a solid of {} blocks in {} layers, {} faces, {} inner squares "
+                        "removed",
+                        s.blocks, s.layers, s.faces, s.inner),
+            o);
+    }
     const rt::LayoutRequest request = layout_request(o);
     // An initial state that is never reached again and is no grid itself: a set of patches.
     bool set_of_patches = request.n_s == 0 && request.cells.empty();

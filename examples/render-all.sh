@@ -58,6 +58,8 @@ for name in fractal_edge spiky_edge c1_edge quad_patch; do
 done
 # Fractal surfaces from bcifs: a patch with seeded facet entries, a closed cube of six rough faces.
 "$frac" mesh "$here/bcifs.frac" rough_patch --depth 6 -o "$out/bcifs_rough_patch.obj"
+# Solids of volume cells (seed 002 sec. 3.3): the arborescent condensation of Bezier blocks, watertight.
+"$frac" mesh "$here/arborescent.frac" arborescent --depth 4 -o "$out/arborescent.stl"
 "$frac" mesh "$here/bcifs.frac" rough_cube --depth 5 -o "$out/bcifs_rough_cube.stl"
 # Junctions of curves built by different processes, solved from seed 004's constraints.
 for j in spline_junction refined_junction fractal_junction; do

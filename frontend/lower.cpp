@@ -830,6 +830,27 @@ private:
         }
     }
 
+    // The faces of every cube topology, for the meshing of solids: its boundary operators B0 ... B5 from
+    // the face cell, generated or written.
+    static void volume_cells(const BcifsDecl& b, ir::Automaton& a,
+                             const std::function<std::size_t(const std::string&)>& index) {
+        for (const TopologyDecl& t : b.topologies) {
+            if (t.kind != "cube") continue;
+            ir::VolumeCell v;
+            v.state = index(t.cell);
+            std::size_t found = 0;
+            for (std::size_t face = 0; face < v.faces.size(); ++face)
+                for (std::size_t j = 0; j < a.embeddings.size(); ++j)
+                    if (a.embeddings[j].from == v.state &&
+                        a.embeddings[j].label == fmt::format("B{}", face)) {
+                        v.faces[face] = j;
+                        ++found;
+                        break;
+                    }
+            if (found == v.faces.size()) a.volume_cells.push_back(v);
+        }
+    }
+
     // The constraint system of a bcifs, from its declaration (the type checker checked every size).
     BcifsSystem bcifs_system(const Item& it, const std::function<std::size_t(const std::string&)>& index) {
         const AutomatonDecl& decl = *it.automaton;
@@ -991,6 +1012,7 @@ private:
             contracts = attempts == 1 || ir::prove_contractive(a).proven;
         }
         triangle_patches(b, a, index);
+        volume_cells(b, a, index);
         if (!contracts)
             fail(it.loc,
                  seeded

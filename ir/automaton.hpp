@@ -92,6 +92,15 @@ struct TrianglePatch {
     std::array<std::size_t, 3> corners; // the weights at the corners (0, 0), (1, 0), (0, 1)
 };
 
+// A cell split as a cube (a bcifs's `topology c = cube(f) split n x n x n`, frontend/topology.hpp): its
+// solid is bounded by the six faces B0 ... B5 (z low, high, y low, high, x low, high), each the face
+// cell's attractor through its boundary operator. The meshing of solids (runtime/automata/solid.hpp)
+// follows it.
+struct VolumeCell {
+    std::size_t state = 0;
+    std::array<std::size_t, 6> faces{}; // indices into Automaton::embeddings, B0 ... B5
+};
+
 struct Automaton {
     std::string name;
     std::vector<State> states;
@@ -105,6 +114,7 @@ struct Automaton {
     // are kept apart from the arcs (junctions, shared boundaries and meshes use them).
     std::vector<Arc> embeddings;
     std::vector<TrianglePatch> triangle_patches;
+    std::vector<VolumeCell> volume_cells;
 
     // The arcs leaving state s, in model order.
     std::vector<std::size_t> arcs_from(std::size_t s) const;

@@ -27,14 +27,15 @@ using num::Rational;
 // The depth in [0, 24], at most 2^26 of what `count()` counts (vertices or triangles), an output in R3
 // or less: the checks every tessellation makes before its work. Returns the output dimension.
 template <class Count>
-int check_tessellation(const ir::Automaton& a, int depth, Count&& count, const char* what) {
+int check_tessellation(const ir::Automaton& a, int depth, Count&& count, const char* what,
+                       const Matrix<double>* output = nullptr) {
     if (depth < 0 || depth > 24)
         throw std::invalid_argument(fmt::format("tessellation depth {} is outside [0, 24]", depth));
     const double n = count();
     if (n > static_cast<double>(std::uint64_t{1} << 26))
         throw std::invalid_argument(
             fmt::format("a tessellation at depth {} would have {:.3g} {} (at most 2^26)", depth, n, what));
-    const int out_dim = a.output_dimension();
+    const int out_dim = output ? static_cast<int>(output->rows()) - 1 : a.output_dimension();
     if (out_dim > 3)
         throw std::invalid_argument(
             fmt::format("{} is drawn in R{}: a mesh needs R3 or less", a.name, out_dim));
@@ -402,7 +403,8 @@ SurfaceLayout infer_layout(const ir::Automaton& a, const LayoutRequest& request)
         a.name, first_failure));
 }
 
-Tessellation tessellate(const ir::Automaton& a, const SurfaceLayout& layout, int depth) {
+Tessellation tessellate(const ir::Automaton& a, const SurfaceLayout& layout, int depth,
+                        const num::Matrix<double>* output) {
     const std::vector<std::size_t> states = laid_out_states(a, layout);
     const CellLayout& root = *layout.states[layout.root];
     const int out_dim = check_tessellation(
@@ -411,7 +413,7 @@ Tessellation tessellate(const ir::Automaton& a, const SurfaceLayout& layout, int
             return (std::pow(static_cast<double>(root.n_s), depth) + 1) *
                    (root.dimension == 2 ? std::pow(static_cast<double>(root.n_t), depth) + 1 : 1);
         },
-        "vertices");
+        "vertices", output);
 
     Tessellation t;
     t.dimension = root.dimension;
@@ -440,7 +442,7 @@ Tessellation tessellate(const ir::Automaton& a, const SurfaceLayout& layout, int
     }
 
     // Composites P T_1 ... T_d (output rows only, 3 x n_q, row-major), one buffer per level.
-    const Matrix<double> out = output_matrix(a);
+    const Matrix<double> out = output ? *output : output_matrix(a);
     std::size_t widest = 0;
     for (const std::size_t q : states)
         widest = std::max(widest, static_cast<std::size_t>(a.states[q].space.coordinates()));

@@ -79,8 +79,10 @@ struct Tessellation {
 };
 
 // The grid of vertices at depth p in [0, 24]; at most 2^26 vertices. The layout must have passed
-// check_layout (infer_layout's has).
-Tessellation tessellate(const ir::Automaton& a, const SurfaceLayout& layout, int depth);
+// check_layout (infer_layout's has). Drawn through `output` (homogeneous rows over the initial state's
+// space) when given, else through the projection.
+Tessellation tessellate(const ir::Automaton& a, const SurfaceLayout& layout, int depth,
+                        const num::Matrix<double>* output = nullptr);
 
 // Two triangles per grid square, counter-clockwise around ds x dt. Throws for a curve.
 Mesh surface_mesh(const Tessellation& t);
