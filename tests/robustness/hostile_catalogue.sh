@@ -11,6 +11,8 @@ make_hostile_catalogue() {
     { printf 'shape s(x, y) = '; repeat 'f' 100000 | sed 's/f/f(/g'; printf x; repeat ')' 100000; printf ';\n'; } > calls_1e5.frac
     { printf 'shape s(x, y) = x'; repeat '^' 300000 | sed 's/\^/^x/g'; printf ';\n'; } > power_chain_3e5.frac
     { printf 'shape s(x, y) = x'; repeat '+' 1000000 | sed 's/+/ + x/g'; printf ';\n'; } > plus_chain_1e6.frac
+    # Within the limits (199,999 operators): compiled and evaluated, not refused.
+    { printf 'shape s(x, y) = x'; repeat '+' 199999 | sed 's/+/ + x/g'; printf ';\n'; } > plus_chain_2e5.frac
     { printf 'shape s(x, y) = x'; repeat '.' 1000000 | sed 's/\./.x/g'; printf ';\n'; } > field_chain_1e6.frac
     { printf 'shape s(x, y) = x + '; repeat 9 1000000; printf ';\nshape t(x, y) = 1e999999999 - x;\n'; } > huge_literal.frac
     { printf 'shape s(x, y) = x '; printf '\xff\xfe\xc3\x28 '; printf '+ y;\n'; } > invalid_utf8.frac

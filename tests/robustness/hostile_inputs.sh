@@ -49,5 +49,15 @@ expect_error inline_explosion "more than the limit of 2000000"
 expect_error special_imports "cannot read '/proc/self/mem': read error"
 expect_error import_dev_zero "cannot import '/dev/zero': not a regular file"
 expect_error import_directory "is a directory"
+
+# At the limits, evaluated: a sum of 200,000 terms (one function LLVM would take hours and gigabytes to
+# compile) is interpreted, never a blow-up.
+timeout 20 "$frac" eval plus_chain_2e5.frac s --at 0.5,0 > plus_chain_2e5.out 2> plus_chain_2e5.err
+status=$?
+if [ $status -ne 0 ]; then
+    fail "plus_chain_2e5: eval exit $status (want 0); stderr: $(head -c 300 plus_chain_2e5.err)"
+elif ! grep -q "^s = 100000$" plus_chain_2e5.out; then
+    fail "plus_chain_2e5: eval printed $(head -c 300 plus_chain_2e5.out) (want s = 100000)"
+fi
 [ $failures -eq 0 ] && echo "ok: every hostile input gave its located error"
 exit $((failures > 0))
