@@ -40,9 +40,10 @@ std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId
     if (options.engine == "jit" && too_long && !prunable_and_large) {
         static bool told = false; // say it once per run
         if (!told)
-            std::cerr << fmt::format("frac: note: {} instructions are more than the JIT compiles in reasonable "
-                                     "time ({}); using the interpreter\n",
-                                     tape.instruction_count(), jit_max_instructions);
+            std::cerr << fmt::format(
+                "frac: note: {} instructions are more than the JIT compiles in reasonable "
+                "time ({}); using the interpreter\n",
+                tape.instruction_count(), jit_max_instructions);
         told = true;
     } else if (options.engine == "jit" && !prunable_and_large) {
         std::string why;

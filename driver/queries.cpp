@@ -11,11 +11,12 @@
 namespace frac::driver {
 
 ir::Interval automaton_dimension(const front::AutomatonInfo& a) {
-    const rt::SimilarityDimension d = rt::similarity_dimension(a.automaton);
+    const rt::SimilarityDimension d = a.fif_points.empty() ? rt::similarity_dimension(a.automaton)
+                                                           : rt::fif_box_dimension(a.automaton, a.fif_points);
     if (!d.defined)
-        throw RunError(fmt::format("dimension of '{}': {} (its similarity dimension needs similitudes; "
-                                   "frac dimension FILE {} counts boxes of its cover)",
-                                   a.name, d.reason, a.name));
+        throw RunError(fmt::format(
+            "dimension of '{}': {} ({}frac dimension FILE {} counts boxes of its cover)", a.name, d.reason,
+            a.fif_points.empty() ? "its similarity dimension needs similitudes; " : "", a.name));
     return d.bracket;
 }
 

@@ -5,6 +5,7 @@
 #include "frontend/lexer.hpp"
 #include "frontend/limits.hpp"
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -164,9 +165,29 @@ inline bool is_unknown(const Expr& e) {
     return e.kind == ExprKind::name && e.text == "?";
 }
 
+// A fractal interpolation function or curve (seed 001 sec. 2):
+//   fif NAME { points (t0, x0), ..., (tN, xN); | data "file.csv";
+//              scale c1, ..., cN; | scale c;       (curves: c, (cx, cy) or [[cxx, cxy], [cyx, cyy]])
+//              [domains (j1, k1), ..., (jN, kN);] }
+// Piece i is the shear T_i (eq. 1; eq. 8/9 for a curve (t, x, y)) with T_i(P_j) = P_(i-1) and T_i(P_k) = P_i
+// for its domain (j, k) (default (0, N): a FIF; k < j: the "reflected" constraints; other domains: an
+// RFIF). frontend/fif.hpp expands it into the states and arcs of a cifs after parsing.
+struct FifDecl {
+    std::vector<ExprPtr> points; // tuples (t, x) or (t, x, y)
+    std::string data;            // a CSV file of rows t, x[, y], relative to the model, instead of points
+    Location points_loc, data_loc, scale_loc, domains_loc;
+    std::vector<ExprPtr> scales;
+    std::vector<std::array<int, 2>> domains; // point indices (j, k), one per piece, or empty
+    std::vector<Location> domain_locs;
+    std::vector<ExprPtr> values; // set by the expansion: every point as a tuple (t, x[, y])
+    bool curve = false;          // set by the expansion: points of three coordinates
+    std::size_t pieces = 0;      // set by the expansion
+};
+
 struct AutomatonDecl {
     bool graph_directed = false;      // cifs or bcifs; an ifs has one state, named as the automaton
     std::shared_ptr<BcifsDecl> bcifs; // a bcifs: its states are the cells
+    std::shared_ptr<FifDecl> fif;     // a fif: its states and arcs are generated from it
     std::vector<StateDecl> states;
     std::vector<ArcDecl> arcs;
     std::string initial; // empty: the first state

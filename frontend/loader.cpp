@@ -1,4 +1,5 @@
 #include "frontend/loader.hpp"
+#include "frontend/fif.hpp"
 
 #include "frontend/resolve.hpp"
 #include "frontend/suggest.hpp"
@@ -15,8 +16,6 @@
 #include <sstream>
 
 namespace frac::front {
-
-namespace {
 
 bool read_file(const std::string& path, std::size_t max_file_bytes, std::string& text, std::string& why) {
     std::error_code ec;
@@ -45,6 +44,8 @@ bool read_file(const std::string& path, std::size_t max_file_bytes, std::string&
     }
     return true;
 }
+
+namespace {
 
 // Renames the definitions of a module imported `as alias` to alias.name, and the uses of them in the
 // module's own bodies (a parameter or a local of the same name is not a use).
@@ -162,6 +163,8 @@ public:
         }
         for (Item& it : p.items) {
             if (it.kind == ItemKind::import) import(it, dir);
+            if (it.kind == ItemKind::automaton && it.automaton && it.automaton->fif)
+                expand_fif(it, dir, limits_.max_file_bytes, c_.diags);
             into_.items.push_back(std::move(it));
         }
     }

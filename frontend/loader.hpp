@@ -32,6 +32,9 @@ struct LoadTimes {
     double lex = 0, parse = 0;
 };
 
+// Reads a file of at most max_file_bytes (a directory, a read error or a larger file: false, with why).
+bool read_file(const std::string& path, std::size_t max_file_bytes, std::string& text, std::string& why);
+
 // Reads, lexes and parses `path` and its imports into c.program. A file that cannot be read is an
 // error in c.diags; returns whether the main file was read.
 // Of `limits`, the size of files, the depth of imports and what the parser limits.

@@ -699,10 +699,52 @@ private:
 
     // The checks that need the operators' values (ir/automaton_check.hpp): barycentric columns summing
     // to 1, probabilities, dead ends, unreachable states (a warning), and a proof of contraction.
-    void check(AutomatonInfo& info, bool cells = false) {
+    // A fif's pieces contract under the metric of seed 001's eq. 2, d((t, X), (t', X')) = |t - t'| +
+    // (1 - A) / (2B) |X - X'| (A = max |a_i|, B > max |b_i|, max norm on X): each shear contracts by
+    // s = max((1 + A) / 2, C) with C = max |C_i| (max row sum), so s < 1 iff A < 1 and C < 1. Bounds
+    // from the operators' enclosures. Returns the proof, or reports the first piece that fails.
+    std::optional<std::string> fif_contraction(const AutomatonInfo& info) {
+        double a_max = 0, c_max = 0;
+        for (std::size_t i = 0; i < info.automaton.arcs.size(); ++i) {
+            const ir::Arc& arc = info.automaton.arcs[i];
+            if (arc.label.empty()) continue; // the union's identity arcs (an RFIF), taken once
+            const auto& m = arc.op.enclosure;
+            const double a = num::magnitude(m(0, 0));
+            double c = 0;
+            for (std::size_t r = 1; r + 1 < m.rows(); ++r) {
+                double row = 0;
+                for (std::size_t k = 1; k + 1 < m.cols(); ++k) row += num::magnitude(m(r, k));
+                c = std::max(c, row);
+            }
+            if (a >= 1)
+                d_.error(
+                    info.arc_locs.at(i),
+                    fmt::format("'{}': piece {} does not contract (eq. 2): |a| = {:.6g} >= 1, its domain is "
+                                "no longer than its range",
+                                info.name, arc.label, a));
+            else if (c >= 1)
+                d_.error(
+                    info.arc_locs.at(i),
+                    fmt::format("'{}': piece {} does not contract (eq. 2): its vertical scaling has norm "
+                                "{:.6g} >= 1",
+                                info.name, arc.label, c));
+            if (a >= 1 || c >= 1) return std::nullopt;
+            a_max = std::max(a_max, a);
+            c_max = std::max(c_max, c);
+        }
+        return fmt::format(
+            "contractive under the metric of eq. 2: s = max((1 + A)/2, C) = {:.6g} < 1 (A = max "
+            "|a_i| = {:.6g}, C = max |c_i| = {:.6g})",
+            std::max((1 + a_max) / 2, c_max), a_max, c_max);
+    }
+
+    void check(AutomatonInfo& info, bool cells = false, const FifDecl* fif = nullptr) {
+        std::optional<std::string> eq2;
+        if (fif && !(eq2 = fif_contraction(info))) throw AlreadyReported{};
         ir::ContractivityResult proof;
         bool failed = false;
         for (const ir::AutomatonProblem& p : ir::check_automaton(info.automaton, {}, &proof)) {
+            if (eq2 && p.kind == ir::AutomatonProblem::Kind::contractivity) continue;
             // A bcifs reaches its lower cells through boundary operators, which are no arcs.
             if (cells && p.kind == ir::AutomatonProblem::Kind::unreachable) continue;
             const Location loc = p.arc     ? info.arc_locs.at(*p.arc)
@@ -718,7 +760,7 @@ private:
             failed = true;
         }
         if (failed) throw AlreadyReported{};
-        info.contraction = proof.message;
+        info.contraction = eq2 ? *eq2 : proof.message;
     }
 
     // ---- bcifs ----
@@ -1080,7 +1122,15 @@ private:
         }
         a.initial = index(initial_state(decl).name);
         if (decl.projection) a.projection = closed(*decl.projection, Context::constant).linear->in(0);
-        check(info, decl.bcifs != nullptr);
+        if (decl.fif)
+            for (const ExprPtr& point : decl.fif->values) {
+                const Value v = closed(*point, Context::constant);
+                std::vector<double> coordinates;
+                for (const NodeId node : v.nodes)
+                    coordinates.push_back(num::midpoint(entry(Value::scalar(node), point->loc).enclosure));
+                info.fif_points.push_back(std::move(coordinates));
+            }
+        check(info, decl.bcifs != nullptr, decl.fif.get());
         m_.automata.push_back(std::move(info));
         automaton_index_[&it] = m_.automata.size() - 1;
     }

@@ -33,6 +33,8 @@ struct AutomatonInfo {
     // entries took), and the degrees of freedom by state.
     std::string solution;
     std::vector<int> dof;
+    // A fif: its interpolation points (t, x[, y]), nearest doubles.
+    std::vector<std::vector<double>> fif_points;
 };
 
 // A run-time question a test asks of a shape or an automaton; its answer is the input Var(index) of

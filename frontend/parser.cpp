@@ -2,6 +2,8 @@
 #include "frontend/ast.hpp"
 
 #include <fmt/format.h>
+
+#include <charconv>
 #include <set>
 
 namespace frac::front {
@@ -83,7 +85,9 @@ private:
     // `ifs` and `cifs` are words of the language only where a definition starts (they stay usable as
     // names elsewhere).
     bool at_automaton() const {
-        return at(Tok::ident) && (cur().text == "ifs" || cur().text == "cifs" || cur().text == "bcifs") &&
+        return at(Tok::ident) &&
+               (cur().text == "ifs" || cur().text == "cifs" || cur().text == "bcifs" ||
+                cur().text == "fif") &&
                ahead(1).kind == Tok::ident;
     }
     bool at_word(const char* word) const { return at(Tok::ident) && cur().text == word; }
@@ -160,9 +164,9 @@ private:
             expect(Tok::semicolon, "after print");
             return it;
         default:
-            fail(fmt::format(
-                "expected a definition (fn, const, shape, ifs, cifs, bcifs, test, import or print), found {}",
-                describe(cur())));
+            fail(fmt::format("expected a definition (fn, const, shape, ifs, cifs, bcifs, fif, test, import "
+                             "or print), found {}",
+                             describe(cur())));
         }
     }
 
@@ -173,6 +177,7 @@ private:
     //              subdivide e { T0 [-> c] = OP; }
     //              boundary e from v { B0 = OP; } e.B0 * v.T0 == e.T0 * e.B0; fix e.T0[r][c] = E; ... }
     Item automaton(Item it) {
+        if (at_word("fif")) return fif(std::move(it));
         const std::string word = take().text;
         const bool graph_directed = word != "ifs";
         it.kind = ItemKind::automaton;
@@ -203,6 +208,68 @@ private:
         expect(Tok::rbrace, "to close the automaton");
         it.automaton = std::move(a);
         return it;
+    }
+
+    // fif NAME { points P0, ..., PN; | data "FILE"; scale C1, ..., CN; [domains (j, k), ...;] } (ast.hpp)
+    Item fif(Item it) {
+        take();
+        it.kind = ItemKind::automaton;
+        it.name = expect(Tok::ident, "after 'fif'").text;
+        auto a = std::make_shared<AutomatonDecl>();
+        a->graph_directed = true;
+        a->fif = std::make_shared<FifDecl>();
+        FifDecl& f = *a->fif;
+        expect(Tok::lbrace, "to open the fif");
+        while (!at(Tok::rbrace) && !at(Tok::end)) {
+            try {
+                const Token& word = expect(Tok::ident, "(points, data, scale or domains) in a fif");
+                if (word.text == "points") {
+                    f.points_loc = word.loc;
+                    do f.points.push_back(expr());
+                    while (accept(Tok::comma));
+                } else if (word.text == "data") {
+                    f.data_loc = word.loc;
+                    f.data = expect(Tok::string, "(the CSV file) after 'data'").text;
+                } else if (word.text == "scale") {
+                    f.scale_loc = word.loc;
+                    do f.scales.push_back(expr());
+                    while (accept(Tok::comma));
+                } else if (word.text == "domains") {
+                    f.domains_loc = word.loc;
+                    do {
+                        f.domain_locs.push_back(cur().loc);
+                        expect(Tok::lparen, "to open a domain (j, k): the indices of its end points");
+                        const int j = point_index();
+                        expect(Tok::comma, "between the domain's two point indices");
+                        const int k = point_index();
+                        expect(Tok::rparen, "to close the domain");
+                        f.domains.push_back({j, k});
+                    } while (accept(Tok::comma));
+                } else {
+                    throw CompileError(word.loc,
+                                       fmt::format("expected points, data, scale or domains in a fif, "
+                                                   "found '{}'",
+                                                   word.text));
+                }
+                expect(Tok::semicolon, "after the fif statement");
+            } catch (const CompileError& e) {
+                diags_.error(e.loc, e.what());
+                while (!at(Tok::semicolon) && !at(Tok::rbrace) && !at(Tok::end)) take();
+                accept(Tok::semicolon);
+            }
+        }
+        expect(Tok::rbrace, "to close the fif");
+        it.automaton = std::move(a);
+        return it;
+    }
+
+    int point_index() {
+        const Token& n = expect(Tok::number, "(a point index, counted from 0)");
+        int v = 0;
+        const auto [end, ec] = std::from_chars(n.text.data(), n.text.data() + n.text.size(), v);
+        if (ec != std::errc() || end != n.text.data() + n.text.size() || v < 0)
+            throw CompileError(n.loc, fmt::format("a point index is a whole number from 0, not {}", n.text));
+        return v;
     }
 
     void automaton_stmt(AutomatonDecl& a, const std::string& name) {

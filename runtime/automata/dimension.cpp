@@ -14,6 +14,24 @@ namespace {
 
 using num::Interval;
 using num::Matrix;
+
+// The root of rho(s) = 1 between lo (rho proven > 1) and hi (rho proven < 1), rho decreasing, bracketed
+// by two one-sided bisections: the largest s proven below the root and the smallest proven above it.
+// (One bisection would stall on an s the enclosure cannot decide, such as an exact root.)
+template <class Rho>
+Interval bracket_root(Rho&& rho, double lo, double hi, double tolerance) {
+    auto squeeze = [&](double yes, double no, auto&& proven) {
+        for (int it = 0; it < 200 && std::abs(no - yes) > tolerance / 2; ++it) {
+            const double mid = yes + (no - yes) / 2;
+            if (mid == yes || mid == no) break;
+            (proven(rho(mid)) ? yes : no) = mid;
+        }
+        return yes;
+    };
+    const double below = squeeze(lo, hi, [](Interval b) { return b.lo > 1.0; });
+    const double above = squeeze(hi, lo, [](Interval b) { return b.hi < 1.0; });
+    return Interval(below, above);
+}
 using num::Rational;
 
 std::string arc_title(const ir::Automaton& a, std::size_t i) {
@@ -161,22 +179,8 @@ SimilarityDimension similarity_dimension(const ir::Automaton& a, double toleranc
                 return out;
             }
         }
-        // Two one-sided bisections: the largest s proven below the root and the smallest proven
-        // above it. (One bisection would stall on an s the enclosure cannot decide, such as an
-        // exact root.)
-        auto squeeze = [&](double yes, double no, auto&& proven) {
-            for (int it = 0; it < 200 && std::abs(no - yes) > tolerance / 2; ++it) {
-                const double mid = yes + (no - yes) / 2;
-                if (mid == yes || mid == no) break;
-                (proven(rho(mid)) ? yes : no) = mid;
-            }
-            return yes;
-        };
-        const double below = squeeze(lo, hi, [](Interval b) { return b.lo > 1.0; });
-        const double above = squeeze(hi, lo, [](Interval b) { return b.hi < 1.0; });
-        lo = below;
-        hi = above;
-        best = Interval(std::max(best.lo, lo), std::max(best.hi, hi));
+        const Interval root = bracket_root(rho, lo, hi, tolerance);
+        best = Interval(std::max(best.lo, root.lo), std::max(best.hi, root.hi));
     }
     if (!any_cycle) {
         out.reason = "no state reachable from the initial state lies on a cycle";
@@ -185,6 +189,71 @@ SimilarityDimension similarity_dimension(const ir::Automaton& a, double toleranc
     out.defined = true;
     out.bracket = best;
     out.value = best.lo + (best.hi - best.lo) / 2;
+    return out;
+}
+
+SimilarityDimension fif_box_dimension(const ir::Automaton& a, const std::vector<std::vector<double>>& points,
+                                      double tolerance) {
+    SimilarityDimension out;
+    out.method = a.states.size() == 1 ? "fractal interpolation function: sum |c_i| a_i^(D-1) = 1"
+                                      : "recurrent fractal interpolation function: rho(M(D)) = 1";
+    if (points.size() < 2 || points.front().size() != 2) {
+        out.reason = "the theory gives the box dimension of the graph of a function (t, x), not of a curve";
+        return out;
+    }
+    out.defined = true;
+    out.bracket = Interval(1.0);
+    out.value = 1;
+    // Collinear points: the graph is the segment through them.
+    const auto& p0 = points.front();
+    const auto& pn = points.back();
+    const double scale = std::abs(pn[0] - p0[0]) + std::abs(pn[1] - p0[1]);
+    bool collinear = true;
+    for (const auto& p : points)
+        collinear = collinear && std::abs((pn[0] - p0[0]) * (p[1] - p0[1]) -
+                                          (pn[1] - p0[1]) * (p[0] - p0[0])) <= 1e-12 * scale * scale;
+    if (collinear) {
+        out.method += " (collinear points: a segment, D = 1)";
+        return out;
+    }
+    // Per strongly connected component of the ranges (the pieces are the labelled arcs; an RFIF's union
+    // state reaches the ranges by unlabelled identities): the largest root, 1 when rho(M(1)) <= 1.
+    const std::vector<bool> live = ir::reachable_states(a);
+    int components = 0;
+    const std::vector<int> comp = ir::strongly_connected_components(a, live, &components);
+    for (int c = 0; c < components; ++c) {
+        std::vector<std::size_t> index(a.states.size(), 0), inner;
+        std::size_t members = 0;
+        for (std::size_t q = 0; q < a.states.size(); ++q)
+            if (comp[q] == c) index[q] = members++;
+        for (std::size_t i = 0; i < a.arcs.size(); ++i)
+            if (!a.arcs[i].label.empty() && live[a.arcs[i].from] && comp[a.arcs[i].from] == c &&
+                comp[a.arcs[i].to] == c)
+                inner.push_back(i);
+        if (inner.empty()) continue;
+        auto rho = [&](double dim) {
+            Matrix<Interval> m(members, members);
+            const num::UpwardRounding up;
+            for (const std::size_t i : inner) {
+                const auto& op = a.arcs[i].op.enclosure;
+                const Interval ratio = num::abs(op(0, 0)), scaling = num::abs(op(1, 1));
+                const Interval term =
+                    num::mul(scaling, dim == 1.0 ? Interval(1.0) : num::pow(ratio, Interval(dim - 1.0)));
+                const std::size_t r = index[a.arcs[i].from], k = index[a.arcs[i].to];
+                m(r, k) = num::add(m(r, k), term);
+            }
+            return ir::spectral_radius_bracket(m);
+        };
+        if (!(rho(1.0).lo > 1.0)) continue; // D = 1 for this component
+        if (!(rho(2.0).hi < 1.0)) {
+            out.defined = false;
+            out.reason = "rho(M(2)) is not below 1: the pieces do not shrink areas";
+            return out;
+        }
+        const Interval root = bracket_root(rho, 1.0, 2.0, tolerance);
+        out.bracket = Interval(std::max(out.bracket.lo, root.lo), std::max(out.bracket.hi, root.hi));
+    }
+    out.value = out.bracket.lo + (out.bracket.hi - out.bracket.lo) / 2;
     return out;
 }
 

@@ -46,4 +46,14 @@ struct SimilarityDimension {
 // Throws std::invalid_argument on a structurally invalid automaton (run ir::check_automaton first).
 SimilarityDimension similarity_dimension(const ir::Automaton& a, double tolerance = 1e-13);
 
+// The box dimension of the graph of a fractal interpolation function (a `fif` over R2, frontend/fif.hpp)
+// from its shears (t, x) -> (a t + d, b t + c x + e): Barnsley's theorem for a FIF (sum |c_i| a_i^(D-1)
+// = 1) and its recurrent form for an RFIF (Barnsley, Elton, Hardin: the spectral radius of M(D),
+// M(D)[i][m] = |c_i| a_i^(D-1) when the domain of piece i covers range m, equals 1). D = 1 when the
+// interpolation points are collinear or when rho(M(1)) <= 1. The bracket is proven as for similarity
+// dimensions (outward-rounded Collatz-Wielandt bounds). Curves (eq. 8/9) get defined = false: their
+// dimension is found by box counting.
+SimilarityDimension fif_box_dimension(const ir::Automaton& a, const std::vector<std::vector<double>>& points,
+                                      double tolerance = 1e-13);
+
 } // namespace frac::rt
