@@ -13,18 +13,23 @@
 //    best quality whose file is no larger than the model. The data are written to OUTPUT_DIR for
 //    `frac fit`: paraboloid_82.csv (the generated ground truth) and earth_82.png.
 #include "bench/bench_common.hpp"
+#include "runtime/fit/least_squares.hpp"
 #include "runtime/fit/projected_ifs.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <vector>
 
 #include <fmt/format.h>
 #include <jpeglib.h>
 #include <png.h>
+#include <zlib.h>
 
 namespace {
 
@@ -36,6 +41,9 @@ constexpr double high_psnr = 39.0;  // a level near where the paraboloid fit set
 // The real grey image: xplanet-images' map of the earth, made grey and cut to its central square (the
 // package's sun map is uniform there).
 constexpr const char* real_images[][2] = {{"/usr/share/xplanet/images/earth.jpg", "earth_82.png"}};
+// Real rough data from python-matplotlib-data: a digital elevation model (Jacksboro fault, 344 x 403
+// int16 heights in an .npz archive) and an EEG recording (800 x 4 float64, channel 0 used).
+constexpr const char* sample_data = "/usr/share/matplotlib/mpl-data/sample_data/";
 
 struct SpeedRun {
     double to_paper = -1, to_high = -1, seconds = 0;
@@ -166,6 +174,118 @@ void write_grey_png(const HeightGrid& g, const std::string& path) {
         fmt::print(stderr, "cannot write {}\n", path);
 }
 
+// ---- matplotlib's sample data ----
+
+std::vector<unsigned char> read_bytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::uint32_t little(const unsigned char* p, int bytes) {
+    std::uint32_t v = 0;
+    for (int i = bytes - 1; i >= 0; --i) v = (v << 8) | p[i];
+    return v;
+}
+
+// One member of a zip archive (stored or deflated), or empty.
+std::vector<unsigned char> zip_member(const std::vector<unsigned char>& zip, const std::string& name) {
+    std::size_t at = 0;
+    while (at + 30 <= zip.size() && little(&zip[at], 4) == 0x04034b50) {
+        const std::uint32_t method = little(&zip[at + 8], 2), packed = little(&zip[at + 18], 4),
+                            size = little(&zip[at + 22], 4), name_length = little(&zip[at + 26], 2),
+                            extra = little(&zip[at + 28], 2);
+        const std::size_t data = at + 30 + name_length + extra;
+        if (data + packed > zip.size()) break;
+        const std::string member(zip.begin() + static_cast<long>(at + 30),
+                                 zip.begin() + static_cast<long>(at + 30 + name_length));
+        if (member == name) {
+            std::vector<unsigned char> out(size);
+            if (method == 0) {
+                std::copy_n(zip.begin() + static_cast<long>(data), size, out.begin());
+                return out;
+            }
+            z_stream z{};
+            if (method != 8 || inflateInit2(&z, -MAX_WBITS) != Z_OK) return {};
+            z.next_in = const_cast<unsigned char*>(&zip[data]);
+            z.avail_in = packed;
+            z.next_out = out.data();
+            z.avail_out = size;
+            const int status = inflate(&z, Z_FINISH);
+            inflateEnd(&z);
+            return status == Z_STREAM_END ? out : std::vector<unsigned char>{};
+        }
+        at = data + packed;
+    }
+    return {};
+}
+
+// A 2-D little-endian int16 .npy array (C order) as a height grid.
+bool npy_int16_grid(const std::vector<unsigned char>& npy, HeightGrid& out) {
+    if (npy.size() < 10 || npy[0] != 0x93 || npy[6] != 1) return false;
+    const std::size_t header = little(&npy[8], 2);
+    const std::string dict(npy.begin() + 10, npy.begin() + static_cast<long>(10 + header));
+    std::size_t rows = 0, cols = 0;
+    if (dict.find("'<i2'") == std::string::npos || dict.find("'fortran_order': False") == std::string::npos ||
+        std::sscanf(dict.c_str() + dict.find("'shape'"), "'shape': (%zu, %zu)", &rows, &cols) != 2 ||
+        npy.size() < 10 + header + 2 * rows * cols)
+        return false;
+    out.width = cols;
+    out.height = rows;
+    out.z.resize(rows * cols);
+    for (std::size_t i = 0; i < rows * cols; ++i)
+        out.z[i] = static_cast<std::int16_t>(little(&npy[10 + header + 2 * i], 2));
+    return true;
+}
+
+// The central square of a grid averaged down to side x side, scaled to 8 bits over its range.
+HeightGrid central_square_8bit(const HeightGrid& g, std::size_t side) {
+    const std::size_t square = std::min(g.width, g.height), x0 = (g.width - square) / 2,
+                      y0 = (g.height - square) / 2;
+    std::vector<double> z(side * side, 0.0), n(side * side, 0.0);
+    for (std::size_t y = 0; y < square; ++y)
+        for (std::size_t x = 0; x < square; ++x) {
+            const std::size_t i = (y * side / square) * side + x * side / square;
+            z[i] += g.z[(y0 + y) * g.width + x0 + x];
+            n[i] += 1;
+        }
+    for (std::size_t i = 0; i < z.size(); ++i) z[i] /= n[i];
+    const auto [lo, hi] = std::minmax_element(z.begin(), z.end());
+    const double low = *lo, span = *hi - *lo;
+    for (double& v : z) v = std::round((v - low) / span * 255.0);
+    return grey_grid(to_bytes(z), side, side);
+}
+
+// Least-squares PFIF and RFIF fits of a rough 1-D signal: errors before and after 8-bit quantisation
+// of the parameters, model size and ratio against the samples stored as 16-bit integers.
+void signal_table(const std::string& title, const Samples& data) {
+    fmt::print("\n{} ({} samples)\n", title, data.size());
+    fmt::print("  {:<14} {:>10} {:>9} {:>10} {:>9} {:>6} {:>6} {:>8}\n", "model", "max error", "PSNR dB",
+               "max (8-bit)", "PSNR 8-bit", "bytes", "ratio", "seconds");
+    struct Run {
+        bool recurrent;
+        int maps, grid;
+    };
+    for (const Run& run : {Run{false, 8, 48}, Run{false, 16, 48}, Run{true, 8, 0}, Run{true, 16, 0},
+                           Run{true, 32, 0}, Run{true, 64, 0}}) {
+        LeastSquaresOptions options;
+        options.maps = run.maps;
+        options.recurrent = run.recurrent;
+        if (run.grid) options.grid = run.grid;
+        const auto start = std::chrono::steady_clock::now();
+        FractalFunction f = fit_least_squares(data, options);
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const FitError raw = measure(f, data);
+        quantize8(f, data);
+        const FitError e = measure(f, data);
+        const std::size_t bytes = f.parameter_count(); // 8-bit parameters
+        fmt::print("  {:<14} {:>10.4g} {:>9.2f} {:>10.4g} {:>9.2f} {:>6} {:>6.1f} {:>8.2f}\n",
+                   fmt::format("{} {} maps", run.recurrent ? "RFIF" : "PFIF", run.maps), raw.max_error,
+                   raw.psnr, e.max_error, e.psnr, bytes,
+                   2.0 * static_cast<double>(data.size()) / static_cast<double>(bytes), seconds);
+    }
+}
+
 void compression_table(const std::string& title, const HeightGrid& data) {
     FitOptions options;
     options.max_iterations = 60;
@@ -263,6 +383,37 @@ int main(int argc, char** argv) {
         }
         write_grey_png(image, out_dir + "/" + png);
         compression_table(fmt::format("{}, central square averaged down", path), image);
+    }
+
+    // Real rough data shipped by Debian (python-matplotlib-data).
+    const std::string dem_path = std::string(sample_data) + "jacksboro_fault_dem.npz";
+    HeightGrid dem;
+    if (!npy_int16_grid(zip_member(read_bytes(dem_path), "elevation.npy"), dem)) {
+        fmt::print("\n{} is missing or unreadable (python-matplotlib-data, scripts/install-deps.sh)\n",
+                   dem_path);
+    } else {
+        const HeightGrid dem8 = central_square_8bit(dem, side);
+        write_grey_png(dem8, out_dir + "/dem_82.png");
+        compression_table(fmt::format("{} (elevation {} x {}), central square averaged down", dem_path,
+                                      dem.height, dem.width),
+                          dem8);
+    }
+    const std::string eeg_path = std::string(sample_data) + "eeg.dat";
+    const std::vector<unsigned char> eeg = read_bytes(eeg_path);
+    if (eeg.size() != 800 * 4 * sizeof(double)) {
+        fmt::print("\n{} is missing (python-matplotlib-data, scripts/install-deps.sh)\n", eeg_path);
+    } else {
+        Samples signal;
+        std::ofstream csv(out_dir + "/eeg_channel0.csv");
+        csv << "t,x\n";
+        for (std::size_t i = 0; i < 800; ++i) {
+            double v = 0;
+            std::memcpy(&v, &eeg[i * 4 * sizeof(double)], sizeof v);
+            signal.t.push_back(static_cast<double>(i) / 799.0);
+            signal.x.push_back(v);
+            csv << fmt::format("{},{}\n", signal.t.back(), v);
+        }
+        signal_table(fmt::format("{}, channel 0", eeg_path), signal);
     }
     return 0;
 }

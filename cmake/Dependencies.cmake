@@ -8,6 +8,7 @@ find_package(TBB REQUIRED) # parallel subdivision
 find_package(Eigen3 3.3 REQUIRED NO_MODULE) # eigenpairs of subdivision operators (runtime/automata/analysis)
 find_package(Ceres REQUIRED) # Levenberg-Marquardt fitting of projected IFS (runtime/fit)
 find_package(JPEG REQUIRED) # the JPEG side of the fitting benchmark (bench/bench_fit.cpp)
+find_package(ZLIB REQUIRED) # the fitting benchmark reads the .npz of a real elevation model
 
 # LLVM's libc: correctly rounded exp/log/sin/cos/tan that honour the current rounding mode.
 find_library(LLVMLIBC_ARCHIVE llvmlibc PATHS /usr/lib/llvm-19/lib NO_DEFAULT_PATH REQUIRED)

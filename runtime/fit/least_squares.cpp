@@ -114,7 +114,9 @@ struct Fitter {
             ty[i] = s.curve() ? s.y[first + i] : 0;
         }
         for (const auto& [alpha, beta] : domains) {
-            if (!(beta - alpha > hi - lo)) continue;
+            // Longer than the range by more than rounding (grid cuts of equal length differ in the last
+            // bits, and an equal-length domain would not contract: |a| = 1).
+            if (!(beta - alpha > (hi - lo) * (1 + 1e-9))) continue;
             for (int orientation = 0; orientation < 2; ++orientation) {
                 if (only_orientation >= 0 && orientation != only_orientation) continue;
                 const double scale = (beta - alpha) / (hi - lo);

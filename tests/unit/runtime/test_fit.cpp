@@ -9,6 +9,7 @@
 
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <fstream>
 
 using namespace frac::rt::fit;
 
@@ -188,4 +189,32 @@ TEST_CASE("fit: a budget too small stops the fit", "[fit]") {
     HoughOptions h;
     h.seconds = 1e-9;
     CHECK_THROWS_AS(hough_recover(s, h), BudgetExceeded);
+}
+
+TEST_CASE("fit: PFIF of a real EEG signal, domains longer than their ranges", "[fit][pfif]") {
+    // python-matplotlib-data's EEG recording (800 x 4 float64, channel 0; installed by
+    // scripts/install-deps.sh). On a grid of 48 cells, cuts of equal length differ in their last bits, and
+    // a domain of its range's own length (|a| = 1, no contraction) was once taken for 16 maps.
+    std::ifstream in("/usr/share/matplotlib/mpl-data/sample_data/eeg.dat", std::ios::binary);
+    REQUIRE(in);
+    std::vector<double> rows(800 * 4);
+    in.read(reinterpret_cast<char*>(rows.data()), static_cast<std::streamsize>(rows.size() * sizeof(double)));
+    REQUIRE(in.gcount() == static_cast<std::streamsize>(rows.size() * sizeof(double)));
+    Samples eeg;
+    for (std::size_t i = 0; i < 800; ++i) {
+        eeg.t.push_back(static_cast<double>(i) / 799.0);
+        eeg.x.push_back(rows[4 * i]);
+    }
+    LeastSquaresOptions options;
+    options.maps = 16;
+    options.grid = 48;
+    const FractalFunction f = fit_least_squares(eeg, options);
+    REQUIRE(f.pieces.size() == 16);
+    for (const Piece& p : f.pieces) {
+        CHECK(std::abs(p.map.a) < 1);
+        CHECK(p.beta - p.alpha > p.hi - p.lo);
+    }
+    // The fit is close to the signal (the benchmark's table: PSNR about 26 dB, max error below 4).
+    const FitError e = measure(f, eeg);
+    CHECK(e.psnr > 24);
 }
