@@ -7,6 +7,8 @@
 #include "ir/tape.hpp"
 
 #include <fmt/format.h>
+
+#include <cstdlib>
 #include <iostream>
 
 namespace frac::driver {
@@ -28,6 +30,25 @@ constexpr std::size_t jit_max_prunable_instructions = 1000;
 constexpr std::size_t jit_max_instructions = 10000;
 
 } // namespace
+
+void check_compile_size(std::size_t instructions, const std::string& what) {
+    std::size_t limit = 20000;
+    if (const char* env = std::getenv("FRAC_MAX_COMPILE_INSTRUCTIONS")) {
+        char* end = nullptr;
+        const double v = std::strtod(env, &end);
+        if (end == env || *end != '\0' || !(v >= 1) || !(v <= 1e9))
+            throw RunError(fmt::format("FRAC_MAX_COMPILE_INSTRUCTIONS must be a whole number of instructions "
+                                       "from 1 to 10^9, not '{}'",
+                                       env));
+        limit = static_cast<std::size_t>(v);
+    }
+    if (instructions > limit)
+        throw RunError(
+            fmt::format("{} has {} instructions, more than the limit of {} for compiled code (LLVM's "
+                        "compile time grows about quadratically with one function's length: 52 s at "
+                        "20,000) (FRAC_MAX_COMPILE_INSTRUCTIONS raises it)",
+                        what, instructions, limit));
+}
 
 std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId root, int inputs,
                                               const EngineOptions& options) {
@@ -60,6 +81,7 @@ std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId
         told = true;
     } else if (options.engine == "aot") {
         // Asked for by name, so no fallback: a model that cannot be compiled and loaded is an error.
+        check_compile_size(tape.instruction_count(), "the expression");
         try {
             return jit::make_aot(tape, options.eval);
         } catch (const jit::JitError& e) {

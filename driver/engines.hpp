@@ -22,6 +22,10 @@ struct RunError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+// The most instructions one function compiled ahead of time may have (`frac compile`, the aot engine):
+// 20,000 by default, FRAC_MAX_COMPILE_INSTRUCTIONS raises it. Throws RunError naming `what` above it.
+void check_compile_size(std::size_t instructions, const std::string& what);
+
 // An evaluator of the expression `root` reading `inputs` variables (a shape's coordinates, or the
 // answers of queries). When the JIT cannot be used, says why once on stderr and interprets.
 std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId root, int inputs,

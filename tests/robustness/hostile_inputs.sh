@@ -59,5 +59,11 @@ if [ $status -ne 0 ]; then
 elif ! grep -q "^s = 100000$" plus_chain_2e5.out; then
     fail "plus_chain_2e5: eval printed $(head -c 300 plus_chain_2e5.out) (want s = 100000)"
 fi
+# ... and refused, with its limit, where it would be compiled ahead of time.
+timeout 20 "$frac" compile plus_chain_2e5.frac -o plus_chain_2e5.o > /dev/null 2> plus_chain_2e5.compile.err
+status=$?
+if [ $status -ne 1 ] || ! grep -q "more than the limit of 20000 for compiled code" plus_chain_2e5.compile.err; then
+    fail "plus_chain_2e5: compile exit $status (want 1 and the limit); stderr: $(head -c 300 plus_chain_2e5.compile.err)"
+fi
 [ $failures -eq 0 ] && echo "ok: every hostile input gave its located error"
 exit $((failures > 0))
