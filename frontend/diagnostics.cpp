@@ -58,15 +58,20 @@ std::string bounded(std::string message) {
 } // namespace
 
 void Diagnostics::error(Location loc, std::string message) {
+    message = bounded(std::move(message));
+    skipping_notes_ = !said_.insert({loc.file, loc.line, loc.column, message}).second;
+    if (skipping_notes_) return;
     ++errors_;
-    if (errors_ <= max_errors) list_.push_back({Severity::error, loc, bounded(std::move(message))});
+    if (errors_ <= max_errors) list_.push_back({Severity::error, loc, std::move(message)});
 }
 
 void Diagnostics::warning(Location loc, std::string message) {
+    skipping_notes_ = false;
     list_.push_back({Severity::warning, loc, bounded(std::move(message))});
 }
 
 void Diagnostics::note(Location loc, std::string message) {
+    if (skipping_notes_) return;
     list_.push_back({Severity::note, loc, bounded(std::move(message))});
 }
 

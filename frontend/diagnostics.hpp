@@ -3,8 +3,10 @@
 #pragma once
 
 #include <cstdint>
+#include <set>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -58,6 +60,10 @@ public:
 private:
     std::vector<Diagnostic> list_;
     std::size_t errors_ = 0;
+    // An error said twice at one place (an expression a declaration copies into several places, as
+    // a fif's points into its shears) is reported once, without its notes.
+    std::set<std::tuple<std::uint32_t, std::uint32_t, std::uint32_t, std::string>> said_;
+    bool skipping_notes_ = false;
 };
 
 // A located user error that aborts the current item (collected into Diagnostics by the caller).

@@ -120,9 +120,10 @@ public:
         }
         if (f_.scales.empty()) {
             d_.error(it_.loc,
-                     fmt::format("fif '{}' needs its vertical scalings: scale c1, ..., c{}; (or one for "
-                                 "all pieces)",
-                                 it_.name, n));
+                     fmt::format("fif '{}' needs the vertical scalings of its {} piece{}: scale {}; (or "
+                                 "one for all pieces)",
+                                 it_.name, n, n == 1 ? "" : "s",
+                                 n == 1 ? std::string("c1") : fmt::format("c1, ..., c{}", n)));
             return;
         }
         if (f_.scales.size() != 1 && f_.scales.size() != n) {

@@ -1083,6 +1083,25 @@ private:
         info.dof = sol->dof;
     }
 
+    // A fif's points, evaluated before its shears (which divide by differences of their t): finite, t
+    // strictly increasing.
+    void fif_points(const FifDecl& f, AutomatonInfo& info) {
+        for (const ExprPtr& point : f.values) {
+            const Value v = closed(*point, Context::constant);
+            std::vector<double> coordinates;
+            for (const NodeId node : v.nodes) {
+                const Entry x = entry(Value::scalar(node), point->loc);
+                if (!std::isfinite(x.enclosure.lo) || !std::isfinite(x.enclosure.hi))
+                    fail(point->loc, "a fif's point has coordinates that are finite numbers");
+                coordinates.push_back(num::midpoint(x.enclosure));
+            }
+            if (!info.fif_points.empty() && !(coordinates[0] > info.fif_points.back()[0]))
+                fail(point->loc, fmt::format("the points of a fif have increasing t: {} follows {}",
+                                             coordinates[0], info.fif_points.back()[0]));
+            info.fif_points.push_back(std::move(coordinates));
+        }
+    }
+
     void automaton_info(const Item& it) {
         if (!automata_lowered_.insert(&it).second) return; // taken cells lower their source first
         const AutomatonDecl& decl = *it.automaton;
@@ -1105,6 +1124,7 @@ private:
             info.state_locs.push_back(s.loc);
         }
         if (decl.bcifs) bcifs_info(it, info, index);
+        if (decl.fif) fif_points(*decl.fif, info);
         for (const ArcDecl& d : decl.arcs) {
             ir::Arc arc;
             arc.from = index(d.from);
@@ -1122,14 +1142,6 @@ private:
         }
         a.initial = index(initial_state(decl).name);
         if (decl.projection) a.projection = closed(*decl.projection, Context::constant).linear->in(0);
-        if (decl.fif)
-            for (const ExprPtr& point : decl.fif->values) {
-                const Value v = closed(*point, Context::constant);
-                std::vector<double> coordinates;
-                for (const NodeId node : v.nodes)
-                    coordinates.push_back(num::midpoint(entry(Value::scalar(node), point->loc).enclosure));
-                info.fif_points.push_back(std::move(coordinates));
-            }
         check(info, decl.bcifs != nullptr, decl.fif.get());
         m_.automata.push_back(std::move(info));
         automaton_index_[&it] = m_.automata.size() - 1;
