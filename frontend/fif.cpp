@@ -109,7 +109,10 @@ public:
         }
         const std::size_t n = points_.size() - 1;
         if (n > max_fif_pieces) {
-            d_.error(at, fmt::format("a fif of {} pieces is more than the limit of {}", n, max_fif_pieces));
+            d_.error(at,
+                     truncated_
+                         ? fmt::format("a fif of more than {} pieces: that is its limit", max_fif_pieces)
+                         : fmt::format("a fif of {} pieces is more than the limit of {}", n, max_fif_pieces));
             return;
         }
         f_.pieces = n;
@@ -134,6 +137,15 @@ public:
         if (!f_.domains.empty() && f_.domains.size() != n) {
             d_.error(f_.domains_loc,
                      fmt::format("{} domains for {} pieces (one per piece)", f_.domains.size(), n));
+            return;
+        }
+        std::size_t arcs = 0; // an RFIF's piece i has an arc to each range its domain covers
+        for (const auto& [j, k] : f_.domains) arcs += static_cast<std::size_t>(std::abs(k - j));
+        if (arcs > max_fif_arcs) {
+            d_.error(f_.domains_loc,
+                     fmt::format("the domains cover {} ranges in all, more than the limit of {} "
+                                 "arcs of a fif",
+                                 arcs, max_fif_arcs));
             return;
         }
         for (std::size_t i = 0; i < f_.domains.size(); ++i) {
@@ -243,7 +255,10 @@ private:
                 data_.push_back(std::move(v));
             }
             points_.push_back(point);
-            if (points_.size() > max_fif_pieces + 1) break; // reported by run()
+            if (points_.size() > max_fif_pieces + 1) { // reported by run()
+                truncated_ = true;
+                break;
+            }
         }
         return true;
     }
@@ -402,6 +417,7 @@ private:
     std::vector<std::vector<const Expr*>> points_; // coordinates of each point (into f_.points or data_)
     std::vector<ExprPtr> data_;                    // numbers read from a data file
     bool curve_ = false;
+    bool truncated_ = false; // a data file with more points than the limit: read up to it
     std::size_t dims_ = 1;
 };
 

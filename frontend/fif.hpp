@@ -20,8 +20,10 @@
 
 namespace frac::front {
 
-// Most pieces a fif may have (points from a data file included).
-inline constexpr std::size_t max_fif_pieces = 100000;
+// Most pieces a fif may have (points from a data file included; 10,000 pieces compile in about 1.5 s
+// and 290 MB), and most arcs (an RFIF has one per range a domain covers).
+inline constexpr std::size_t max_fif_pieces = 10000;
+inline constexpr std::size_t max_fif_arcs = 100000;
 
 // Fills `it.automaton`'s states and arcs from its FifDecl, reading a `data` file relative to `dir`.
 // Reports what is wrong (located) and leaves the automaton without arcs then.

@@ -743,7 +743,9 @@ private:
         if (fif && !(eq2 = fif_contraction(info))) throw AlreadyReported{};
         ir::ContractivityResult proof;
         bool failed = false;
-        for (const ir::AutomatonProblem& p : ir::check_automaton(info.automaton, {}, &proof)) {
+        ir::ContractivityOptions options;
+        if (eq2) options.max_products = 0; // proven already: no search over paths
+        for (const ir::AutomatonProblem& p : ir::check_automaton(info.automaton, options, &proof)) {
             if (eq2 && p.kind == ir::AutomatonProblem::Kind::contractivity) continue;
             // A bcifs reaches its lower cells through boundary operators, which are no arcs.
             if (cells && p.kind == ir::AutomatonProblem::Kind::unreachable) continue;

@@ -25,5 +25,10 @@ make_hostile_catalogue() {
     { echo 'fn f0(x) = x * 0.5;'; for i in $(seq 1 30); do echo "fn f$i(x) = f$((i - 1))(x) + f$((i - 1))(x + 1);"; done; echo 'shape s(x, y) = f30(x) - y;'; } > inline_explosion.frac
     { printf 'import "/proc/self/mem";\nimport "/dev/urandom";\nshape s(x, y) = x;\n'; } > special_imports.frac
     { printf 'import "/dev/zero";\nshape s(x, y) = x;\n'; } > import_dev_zero.frac
+    seq 0 100000 | sed 's/.*/&,0.5/' > fif_rows_1e5.csv
+    { printf 'fif big { data "fif_rows_1e5.csv"; scale 0.5; }\n'; } > fif_data_1e5.frac
+    { printf 'fif wide { points (0, 0)'; seq 1 10000 | sed 's/.*/, (&, 1)/' | tr -d '\n'
+      printf '; scale 0.5; domains '; seq 1 10000 | sed 's/.*/(0, 10000)/' | paste -sd, - | tr -d '\n'
+      printf ';}\n'; } > fif_arcs_1e8.frac
     { printf 'import "/tmp";\nshape s(x, y) = x;\n'; } > import_directory.frac
 }

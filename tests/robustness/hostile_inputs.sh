@@ -49,6 +49,8 @@ expect_error inline_explosion "more than the limit of 2000000"
 expect_error special_imports "cannot read '/proc/self/mem': read error"
 expect_error import_dev_zero "cannot import '/dev/zero': not a regular file"
 expect_error import_directory "is a directory"
+expect_error fif_data_1e5 "a fif of more than 10000 pieces"
+expect_error fif_arcs_1e8 "more than the limit of 100000 arcs"
 
 # At the limits, evaluated: a sum of 200,000 terms (one function LLVM would take hours and gigabytes to
 # compile) is interpreted, never a blow-up.
