@@ -359,10 +359,10 @@ private:
             return {static_cast<std::size_t>(f_.domains[i][0]), static_cast<std::size_t>(f_.domains[i][1])};
         };
         const auto piece_loc = [&](std::size_t i) {
-            return !f_.domain_locs.empty() ? f_.domain_locs[i]
-                   : f_.scales.size() == n ? f_.scales[i]->loc
-                   : f_.scale_loc.line     ? f_.scale_loc
-                                           : it_.loc;
+            return f_.domain_locs.size() == n ? f_.domain_locs[i]
+                   : f_.scales.size() == n    ? f_.scales[i]->loc
+                   : f_.scale_loc.line        ? f_.scale_loc
+                                              : it_.loc;
         };
         a_.states.push_back({it_.name, it_.loc, space, chord(0, n), {}, {}, {}});
         if (!recurrent) {

@@ -576,7 +576,11 @@ private:
     // tabulate(A, t): F(t) at t = i / N^p, N the arcs per state, read as p digits (seed 003, sec. 2).
     Value tabulate(const Expr& e) {
         const Value av = expr(*e.args[0].value);
-        const std::size_t index = automaton_index_.at(av.automaton);
+        const auto found = automaton_index_.find(av.automaton);
+        if (found == automaton_index_.end())
+            fail(e.args[0].loc,
+                 fmt::format("'{}' did not compile, so it cannot be tabulated", av.automaton->name));
+        const std::size_t index = found->second;
         const ir::Automaton& a = m_.automata[index].automaton;
         const NodeId tn = scalar(expr(*e.args[1].value), e.args[1].loc);
         const num::Rational* t = g_.exact_value(tn);
@@ -1167,7 +1171,11 @@ private:
         q.loc = e.loc;
         if (s.automaton) {
             q.kind = Query::Kind::automaton_dimension;
-            q.shape = automaton_index_.at(s.automaton);
+            const auto found = automaton_index_.find(s.automaton);
+            if (found == automaton_index_.end())
+                fail(e.args[0].loc,
+                     fmt::format("'{}' did not compile, so it has no dimension", s.automaton->name));
+            q.shape = found->second;
             m_.queries.push_back(q);
             return Value::scalar(g_.var(static_cast<int>(m_.queries.size() - 1)));
         }
