@@ -76,7 +76,8 @@ int run_compile(const std::string& file, const CompileOptions& o) {
     if (!c) return front::exit_compile_error;
     const std::vector<jit::AotShape> shapes = chosen_shapes(*c, o.shapes);
     for (const jit::AotShape& s : shapes)
-        driver::check_compile_size(s.tape.instruction_count(), fmt::format("shape '{}'", s.name));
+        driver::check_compile_size(s.tape.instruction_count(), compile_instruction_limit(),
+                                   fmt::format("shape '{}'", s.name));
     for (const jit::AotShape& s : shapes)
         if (!jit::is_c_identifier(config.prefix + s.name))
             throw RunError(fmt::format("shape '{}' does not give C names ({}{}_eval_box)", s.name,

@@ -51,6 +51,12 @@ void limit_from_env(const char* name, const char* unit, double most, T& limit) {
 
 } // namespace
 
+std::size_t compile_instruction_limit() {
+    std::size_t limit = driver::EngineOptions{}.max_compile_instructions;
+    limit_from_env("FRAC_MAX_COMPILE_INSTRUCTIONS", "instructions", 1e9, limit);
+    return limit;
+}
+
 front::Limits frontend_limits() {
     front::Limits l;
     // The nesting limits stop where the work thread's stack (cli/main.cpp) would no longer hold every

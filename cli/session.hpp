@@ -33,6 +33,8 @@ void set_free_entry_seed(std::optional<std::uint64_t> seed);
 // FRAC_MAX_SERIES_TERMS, FRAC_MAX_INLINE_NODES, FRAC_MAX_IMPORT_DEPTH, FRAC_MAX_FILE_MB); a UsageError
 // when one is not a number in its range.
 front::Limits frontend_limits();
+// The most instructions of compiled code: 20,000, or FRAC_MAX_COMPILE_INSTRUCTIONS (at most 10^9).
+std::size_t compile_instruction_limit();
 
 // Compiles `path`; on errors prints the diagnostics to stderr and returns null.
 // `times`, when not null, gets the time of each stage run.

@@ -8,7 +8,6 @@
 
 #include <fmt/format.h>
 
-#include <cstdlib>
 #include <iostream>
 
 namespace frac::driver {
@@ -31,17 +30,7 @@ constexpr std::size_t jit_max_instructions = 10000;
 
 } // namespace
 
-void check_compile_size(std::size_t instructions, const std::string& what) {
-    std::size_t limit = 20000;
-    if (const char* env = std::getenv("FRAC_MAX_COMPILE_INSTRUCTIONS")) {
-        char* end = nullptr;
-        const double v = std::strtod(env, &end);
-        if (end == env || *end != '\0' || !(v >= 1) || !(v <= 1e9))
-            throw RunError(fmt::format("FRAC_MAX_COMPILE_INSTRUCTIONS must be a whole number of instructions "
-                                       "from 1 to 10^9, not '{}'",
-                                       env));
-        limit = static_cast<std::size_t>(v);
-    }
+void check_compile_size(std::size_t instructions, std::size_t limit, const std::string& what) {
     if (instructions > limit)
         throw RunError(
             fmt::format("{} has {} instructions, more than the limit of {} for compiled code (LLVM's "
@@ -81,7 +70,7 @@ std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId
         told = true;
     } else if (options.engine == "aot") {
         // Asked for by name, so no fallback: a model that cannot be compiled and loaded is an error.
-        check_compile_size(tape.instruction_count(), "the expression");
+        check_compile_size(tape.instruction_count(), options.max_compile_instructions, "the expression");
         try {
             return jit::make_aot(tape, options.eval);
         } catch (const jit::JitError& e) {

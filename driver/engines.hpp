@@ -14,7 +14,8 @@ namespace frac::driver {
 struct EngineOptions {
     std::string engine = "jit"; // or "interp" (the fallback when the JIT cannot be used), "aot"
     ir::EvalOptions eval;
-    int threads = 0; // subdivision threads; 0: all cores
+    int threads = 0;                              // subdivision threads; 0: all cores
+    std::size_t max_compile_instructions = 20000; // aot: FRAC_MAX_COMPILE_INSTRUCTIONS (cli/session.hpp)
 };
 
 // A user-facing run-time failure (I/O, a computation that cannot be done): message and exit code 1.
@@ -22,9 +23,9 @@ struct RunError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-// The most instructions one function compiled ahead of time may have (`frac compile`, the aot engine):
-// 20,000 by default, FRAC_MAX_COMPILE_INSTRUCTIONS raises it. Throws RunError naming `what` above it.
-void check_compile_size(std::size_t instructions, const std::string& what);
+// Compiled code (`frac compile`, the aot engine) of more than `limit` instructions is refused: LLVM's
+// compile time grows about quadratically with one function's length. Throws RunError naming `what`.
+void check_compile_size(std::size_t instructions, std::size_t limit, const std::string& what);
 
 // An evaluator of the expression `root` reading `inputs` variables (a shape's coordinates, or the
 // answers of queries). When the JIT cannot be used, says why once on stderr and interprets.

@@ -180,8 +180,6 @@ struct FifDecl {
     std::vector<std::array<int, 2>> domains; // point indices (j, k), one per piece, or empty
     std::vector<Location> domain_locs;
     std::vector<ExprPtr> values; // set by the expansion: every point as a tuple (t, x[, y])
-    bool curve = false;          // set by the expansion: points of three coordinates
-    std::size_t pieces = 0;      // set by the expansion
 };
 
 struct AutomatonDecl {

@@ -115,7 +115,6 @@ public:
                          : fmt::format("a fif of {} pieces is more than the limit of {}", n, max_fif_pieces));
             return;
         }
-        f_.pieces = n;
         for (const auto& point : points_) {
             auto tuple = make(ExprKind::tuple, point.front()->loc);
             for (const Expr* c : point) tuple->kids.push_back(copy(*c));
@@ -277,15 +276,7 @@ private:
         return r == c ? copy(s) : number("0", s.loc);
     }
 
-    // (C (X_k - X_j))_r
-    ExprPtr scaled_difference(std::size_t i, std::size_t r, std::size_t j, std::size_t k) const {
-        ExprPtr sum;
-        for (std::size_t c = 0; c < dims_; ++c) {
-            ExprPtr term = scaling(i, r, c) * (value(k, c) - value(j, c));
-            sum = sum ? std::move(sum) + std::move(term) : std::move(term);
-        }
-        return sum;
-    }
+    // (C X_j)_r
     ExprPtr scaled_point(std::size_t i, std::size_t r, std::size_t j) const {
         ExprPtr sum;
         for (std::size_t c = 0; c < dims_; ++c) {
@@ -307,7 +298,8 @@ private:
         m[0].push_back(t(i) - (t(i + 1) - t(i)) / span() * t(j));
         for (std::size_t r = 0; r < dims_; ++r) {
             const auto b = [&] {
-                return (value(i + 1, r) - value(i, r) - scaled_difference(i, r, j, k)) / span();
+                return (value(i + 1, r) - value(i, r) - (scaled_point(i, r, k) - scaled_point(i, r, j))) /
+                       span();
             };
             m[1 + r].push_back(b());
             for (std::size_t c = 0; c < dims_; ++c) m[1 + r].push_back(scaling(i, r, c));
@@ -338,7 +330,6 @@ private:
 
     void build() {
         curve_ = points_.front().size() == 3;
-        f_.curve = curve_;
         dims_ = curve_ ? 2 : 1;
         if (!curve_)
             for (const ExprPtr& s : f_.scales)
@@ -348,7 +339,7 @@ private:
                              "(t, x, y))");
                     return;
                 }
-        const std::size_t n = f_.pieces;
+        const std::size_t n = points_.size() - 1;
         const SpaceDecl space{false, curve_ ? 3 : 2, it_.loc};
         const bool recurrent =
             std::any_of(f_.domains.begin(), f_.domains.end(), [&](const std::array<int, 2>& d) {

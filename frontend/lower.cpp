@@ -559,14 +559,20 @@ private:
         return Value::scalar(g_.external(static_cast<std::int64_t>(k), c[0], c[1], c[2]));
     }
 
+    // The index of an automaton in the module; a located error when it did not compile (its own errors
+    // are reported), saying what cannot be had of it.
+    std::size_t lowered(const Item* it, Location loc, const char* consequence) {
+        const auto found = automaton_index_.find(it);
+        if (found == automaton_index_.end())
+            fail(loc, fmt::format("'{}' did not compile, so {}", it->name, consequence));
+        return found->second;
+    }
+
     // dof(A.cell): a number known once A's constraints are solved (the type checker checked the form).
     Value dof(const Expr& e) {
         const Expr& a = *e.args[0].value;
         const Item* it = globals_.at(a.kids[0]->text);
-        const auto index = automaton_index_.find(it);
-        if (index == automaton_index_.end())
-            fail(e.loc, fmt::format("'{}' did not compile, so its degrees of freedom are unknown", it->name));
-        const AutomatonInfo& info = m_.automata[index->second];
+        const AutomatonInfo& info = m_.automata[lowered(it, e.loc, "its degrees of freedom are unknown")];
         for (std::size_t s = 0; s < info.automaton.states.size(); ++s)
             if (info.automaton.states[s].name == a.text)
                 return Value::scalar(g_.constant(num::Rational(info.dof[s])));
@@ -576,11 +582,7 @@ private:
     // tabulate(A, t): F(t) at t = i / N^p, N the arcs per state, read as p digits (seed 003, sec. 2).
     Value tabulate(const Expr& e) {
         const Value av = expr(*e.args[0].value);
-        const auto found = automaton_index_.find(av.automaton);
-        if (found == automaton_index_.end())
-            fail(e.args[0].loc,
-                 fmt::format("'{}' did not compile, so it cannot be tabulated", av.automaton->name));
-        const std::size_t index = found->second;
+        const std::size_t index = lowered(av.automaton, e.args[0].loc, "it cannot be tabulated");
         const ir::Automaton& a = m_.automata[index].automaton;
         const NodeId tn = scalar(expr(*e.args[1].value), e.args[1].loc);
         const num::Rational* t = g_.exact_value(tn);
@@ -1171,11 +1173,7 @@ private:
         q.loc = e.loc;
         if (s.automaton) {
             q.kind = Query::Kind::automaton_dimension;
-            const auto found = automaton_index_.find(s.automaton);
-            if (found == automaton_index_.end())
-                fail(e.args[0].loc,
-                     fmt::format("'{}' did not compile, so it has no dimension", s.automaton->name));
-            q.shape = found->second;
+            q.shape = lowered(s.automaton, e.args[0].loc, "it has no dimension");
             m_.queries.push_back(q);
             return Value::scalar(g_.var(static_cast<int>(m_.queries.size() - 1)));
         }
