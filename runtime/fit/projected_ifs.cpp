@@ -173,10 +173,22 @@ PatchEvaluator::PatchEvaluator(const PatchParameters& layout, const HeightGrid& 
             s.vertex[2] = base + side_, s.weight[2] = (1 - u) * v;
             s.vertex[3] = base + side_ + 1, s.weight[3] = u * v;
         }
+    contribution_start_.assign(side_ * side_ + 1, 0);
+    for (const Sample& s : samples_)
+        for (int c = 0; c < 4; ++c)
+            if (s.weight[c] != 0) ++contribution_start_[s.vertex[c] + 1];
+    for (std::size_t v = 0; v < side_ * side_; ++v) contribution_start_[v + 1] += contribution_start_[v];
+    contributions_.resize(contribution_start_.back());
+    std::vector<std::size_t> fill(contribution_start_.begin(), contribution_start_.end() - 1);
+    for (std::size_t i = 0; i < samples_.size(); ++i)
+        for (int c = 0; c < 4; ++c)
+            if (samples_[i].weight[c] != 0)
+                contributions_[fill[samples_[i].vertex[c]]++] = {i, samples_[i].weight[c]};
 }
 
-void PatchEvaluator::vertices(const std::vector<double>& params, std::vector<double>& value,
-                              std::vector<double>* gradient) const {
+void PatchEvaluator::vertices(
+    const std::vector<double>& params, std::vector<double>& value,
+    const std::function<void(std::size_t vertex, const double* gradient)>* on_gradient) const {
     const auto& shape = layout_.shape();
     const std::size_t k = shape.controls, kk = k * k, n = shape.split, m = k - 1, g = layout_.grid_side();
     const std::size_t count = layout_.count();
@@ -191,7 +203,7 @@ void PatchEvaluator::vertices(const std::vector<double>& params, std::vector<dou
                     column_point[(i + n * j) * kk + k * r + c] = (m * i + c) + g * (m * j + r);
     const std::size_t levels = static_cast<std::size_t>(shape.depth);
     value.assign(addresses_.size(), 0.0);
-    if (gradient) gradient->assign(addresses_.size() * count, 0.0);
+    std::vector<double> gradient(on_gradient ? count : 0);
     // cols[l]: T_(l+1) ... T_(p-1) lambda_last (cols[p-1] = lambda_last); rows[l]: P T_1 ... T_l.
     std::vector<double> cols(levels * kk), rows(levels * kk);
     for (std::size_t v = 0; v < addresses_.size(); ++v) {
@@ -214,8 +226,9 @@ void PatchEvaluator::vertices(const std::vector<double>& params, std::vector<dou
         double z = 0;
         for (std::size_t q = 0; q < kk; ++q) z += params[q] * cols[q];
         value[v] = z;
-        if (!gradient) continue;
-        double* grad = &(*gradient)[v * count];
+        if (!on_gradient) continue;
+        double* grad = gradient.data();
+        std::fill(grad, grad + count, 0.0);
         for (std::size_t q = 0; q < kk; ++q) grad[q] = cols[q]; // dz / d height
         std::copy(params.begin(), params.begin() + static_cast<std::ptrdiff_t>(kk), rows.begin());
         // d z / d lambda_point[s] = rows_(l-1)[s] * cols_(l+1)[q] for the point in column q of T_l; then
@@ -240,6 +253,7 @@ void PatchEvaluator::vertices(const std::vector<double>& params, std::vector<dou
             }
         }
         accumulate(points[address.back()], &rows[ops * kk], 1.0);
+        (*on_gradient)(v, grad);
     }
 }
 
@@ -255,20 +269,30 @@ void PatchEvaluator::residuals(const std::vector<double>& params, double* out) c
 }
 
 void PatchEvaluator::jacobian(const std::vector<double>& params, double* residuals_out, double* jac) const {
-    std::vector<double> value, gradient;
-    vertices(params, value, &gradient);
-    const std::size_t count = layout_.count(), rows = samples_.size();
-    for (std::size_t s = 0; s < rows; ++s) {
+    // Each vertex's gradient goes straight into the rows of the samples it weighs in (one row per
+    // vertex when the samples are the tabulation's vertices, the paper's case).
+    const std::size_t count = layout_.count();
+    std::vector<char> started(samples_.size(), 0);
+    const std::function<void(std::size_t, const double*)> to_rows = [&](std::size_t v, const double* grad) {
+        for (std::size_t i = contribution_start_[v]; i < contribution_start_[v + 1]; ++i) {
+            const auto [s, w] = contributions_[i];
+            double* row = jac + s * count;
+            if (started[s])
+                for (std::size_t j = 0; j < count; ++j) row[j] += w * grad[j];
+            else if (w == 1)
+                std::copy(grad, grad + count, row);
+            else
+                for (std::size_t j = 0; j < count; ++j) row[j] = w * grad[j];
+            started[s] = 1;
+        }
+    };
+    std::vector<double> value;
+    vertices(params, value, &to_rows);
+    for (std::size_t s = 0; s < samples_.size(); ++s) {
         const Sample& sm = samples_[s];
         double f = 0;
         for (int c = 0; c < 4; ++c) f += sm.weight[c] * value[sm.vertex[c]];
         residuals_out[s] = f - data_.z[s];
-        for (std::size_t j = 0; j < count; ++j) {
-            double d = 0;
-            for (int c = 0; c < 4; ++c)
-                if (sm.weight[c] != 0) d += sm.weight[c] * gradient[sm.vertex[c] * count + j];
-            jac[s * count + j] = d;
-        }
     }
 }
 

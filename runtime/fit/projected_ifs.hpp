@@ -87,17 +87,26 @@ public:
     std::vector<double> approximation(const std::vector<double>& params) const;
 
 private:
-    // Vertex values (and, when gradient is not null, their gradients: vertex-major, count() each).
+    // Vertex values; when on_gradient is given, each vertex's gradient (count() entries, valid only
+    // during the call) is handed to it as it is computed, so no vertex-by-parameter array is built.
     void vertices(const std::vector<double>& params, std::vector<double>& value,
-                  std::vector<double>* gradient) const;
+                  const std::function<void(std::size_t vertex, const double* gradient)>* on_gradient) const;
     struct Sample {
         std::size_t vertex[4];
         double weight[4];
+    };
+    struct Contribution {
+        std::size_t sample;
+        double weight;
     };
     const PatchParameters& layout_;
     const HeightGrid& data_;
     std::size_t side_ = 0; // N^p + 1
     std::vector<Sample> samples_;
+    // The samples each vertex weighs in (nonzero bilinear weights), vertex v's at
+    // contributions_[contribution_start_[v] .. contribution_start_[v + 1]).
+    std::vector<std::size_t> contribution_start_;
+    std::vector<Contribution> contributions_;
     std::vector<std::vector<std::size_t>> addresses_; // per vertex: the p - 1 operators, then the last point
 };
 

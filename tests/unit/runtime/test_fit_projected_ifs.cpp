@@ -11,6 +11,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
+#include <tuple>
 
 using namespace frac;
 using namespace frac::rt::fit;
@@ -41,16 +43,20 @@ std::string temp_file(const std::string& name, const std::string& text) {
 } // namespace
 
 TEST_CASE("fit: the exact Jacobian matches central differences", "[fit]") {
-    // Data of another size than the tabulation: the samples interpolate vertices bilinearly.
-    for (const auto& [shape, side] :
-         {std::pair{small_shape(3, 4, 2), std::size_t{13}}, std::pair{small_shape(2, 3, 3), std::size_t{9}},
-          std::pair{small_shape(3, 3, 2), std::size_t{10}}}) {
-        const HeightGrid data = elliptic_paraboloid(side, side + 1);
+    // Data of another size than the tabulation (the samples interpolate vertices bilinearly), and data
+    // on the tabulation's vertices (each sample one vertex).
+    for (const auto& [shape, width, height] :
+         {std::tuple{small_shape(3, 4, 2), std::size_t{13}, std::size_t{14}},
+          std::tuple{small_shape(2, 3, 3), std::size_t{9}, std::size_t{10}},
+          std::tuple{small_shape(3, 3, 2), std::size_t{10}, std::size_t{11}},
+          std::tuple{small_shape(3, 4, 2), std::size_t{10}, std::size_t{10}}}) {
+        const HeightGrid data = elliptic_paraboloid(width, height);
         const PatchParameters layout(shape);
         const PatchEvaluator evaluator(layout, data);
         const std::vector<double> x = perturbed(layout, data);
         const std::size_t m = evaluator.residual_count(), n = layout.count();
-        std::vector<double> r(m), jac(m * n), plus(m), minus(m);
+        // Every entry must be written: the buffer starts as NaN, as Ceres's may hold anything.
+        std::vector<double> r(m), jac(m * n, std::numeric_limits<double>::quiet_NaN()), plus(m), minus(m);
         evaluator.jacobian(x, r.data(), jac.data());
         double worst = 0;
         for (std::size_t j = 0; j < n; ++j) {
@@ -61,7 +67,9 @@ TEST_CASE("fit: the exact Jacobian matches central differences", "[fit]") {
             evaluator.residuals(xp, plus.data());
             evaluator.residuals(xm, minus.data());
             for (std::size_t s = 0; s < m; ++s)
-                worst = std::max(worst, std::abs((plus[s] - minus[s]) / (2 * h) - jac[s * n + j]));
+                worst = std::max(worst, std::isnan(jac[s * n + j])
+                                            ? std::numeric_limits<double>::infinity()
+                                            : std::abs((plus[s] - minus[s]) / (2 * h) - jac[s * n + j]));
         }
         INFO("split " << shape.split << ", controls " << shape.controls << ", depth " << shape.depth);
         CHECK(worst < 1e-7);
