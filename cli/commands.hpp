@@ -102,6 +102,7 @@ struct FitSurfaceOptions {
     std::string data, output, method = "lm", patches = "3x3", name = "fitted";
     int controls = 4, depth = 0, iterations = 100, bits = 16; // depth 0: chosen from the data's size
     double seconds = 0, target_psnr = 0;
+    bool fit_positions = false; // --fit-xy: the control points' x, y are parameters too (3-D residuals)
 };
 // The surface fit's own options (the data file, -o, --method, --quantize and --name are the command's).
 void add_fit_surface_options(CLI::App* fit, FitSurfaceOptions& options);

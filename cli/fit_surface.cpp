@@ -34,6 +34,9 @@ void add_fit_surface_options(CLI::App* fit, FitSurfaceOptions& o) {
     fit->add_option("--target-psnr", o.target_psnr,
                     "stop once the PSNR reaches this many dB; a fit that does not reach it writes nothing")
         ->check(CLI::Range(0.0, 400.0));
+    fit->add_flag("--fit-xy", o.fit_positions,
+                  "fit the control points' x, y too: residuals are 3-D distances (seed 003 sec. 4.2), so "
+                  "the written surface lies where the samples are, not only at their heights");
 }
 
 bool is_surface_data(const std::string& path) {
@@ -63,7 +66,7 @@ int report_data_error(const rt::fit::DataError& e) {
     return front::exit_compile_error;
 }
 
-constexpr double max_jacobian_bytes = 2e9;
+constexpr double max_fit_bytes = 2e9;
 
 std::size_t parse_patches(const std::string& text) {
     const auto x = text.find('x');
@@ -100,6 +103,7 @@ int run_fit_surface(const FitSurfaceOptions& o) {
     FitOptions options;
     options.shape.split = split;
     options.shape.controls = static_cast<std::size_t>(o.controls);
+    options.shape.positions = o.fit_positions;
     if (o.depth > 0) {
         options.shape.depth = o.depth;
     } else {
@@ -132,21 +136,27 @@ int run_fit_surface(const FitSurfaceOptions& o) {
                 data.width, data.height, data.z.size(), layout->count(), split, split, o.controls,
                 o.controls)));
     const std::size_t side = static_cast<std::size_t>(std::llround(std::pow(split, options.shape.depth))) + 1;
-    // The Jacobian (a row a sample) and the vertices' gradients are dense: refuse what would not fit.
-    const double jacobian_bytes =
-        static_cast<double>(data.z.size() + side * side) * static_cast<double>(layout->count()) * 8.0;
-    if (jacobian_bytes > max_jacobian_bytes)
-        throw UsageError(
-            fmt::format("{} x {} samples and {} x {} vertices of {} parameters would take {:.1f} GB of "
-                        "derivatives (at most {:.1f} GB): downsample the data, or lower --depth",
-                        data.width, data.height, side, side, layout->count(), jacobian_bytes / 1e9,
-                        max_jacobian_bytes / 1e9));
+    // Memory: the Jacobian (a dense row a sample and coordinate; Ceres keeps two copies of it) and the
+    // tabulation (each vertex's address of p digits and its coordinates). Refuse what would not fit.
+    const double jacobian_bytes = 2.0 * static_cast<double>(data.z.size() * layout->coordinate_count()) *
+                                  static_cast<double>(layout->count()) * 8.0;
+    const double tabulation_bytes =
+        static_cast<double>(side * side) *
+        (32.0 + 8.0 * static_cast<double>(static_cast<std::size_t>(options.shape.depth) +
+                                          layout->coordinate_count()));
+    if (jacobian_bytes + tabulation_bytes > max_fit_bytes)
+        throw UsageError(fmt::format(
+            "{} x {} samples and {} x {} vertices of {} parameters would take {:.1f} GB (derivatives {:.1f} "
+            "GB, tabulation {:.1f} GB; at most {:.1f} GB): downsample the data, or lower --depth",
+            data.width, data.height, side, side, layout->count(), (jacobian_bytes + tabulation_bytes) / 1e9,
+            jacobian_bytes / 1e9, tabulation_bytes / 1e9, max_fit_bytes / 1e9));
     std::cout << fmt::format("data: {}, {} x {} samples, peak {}\n", o.data, data.width, data.height,
                              data.peak);
     std::cout << fmt::format(
-        "model: {} x {} sub-patches, {} x {} control points, depth {} ({} x {} vertices), {} "
+        "model: {} x {} sub-patches, {} x {} control points{}, depth {} ({} x {} vertices), {} "
         "parameters\n",
-        split, split, o.controls, o.controls, options.shape.depth, side, side, layout->count());
+        split, split, o.controls, o.controls, o.fit_positions ? " (x, y, z fitted)" : "", options.shape.depth,
+        side, side, layout->count());
     const FitResult fit = fit_patch(data, options);
     if (!fit.converged)
         throw RunError(
@@ -160,6 +170,9 @@ int run_fit_surface(const FitSurfaceOptions& o) {
     std::cout << fmt::format("fit: {} iterations, stopped: {}\n", fit.iterations, fit.stop_reason);
     std::cout << fmt::format("error ({}-bit parameters): max {:.6g}, MSE {:.6g}, PSNR {:.2f} dB\n", o.bits,
                              stats.max_error, stats.mse, stats.psnr);
+    const Drift drift = position_drift(*layout, model.params, data);
+    std::cout << fmt::format("vertices off the samples' x, y: max {:.3g}, RMS {:.3g} (sample units){}\n",
+                             drift.max, drift.rms, o.fit_positions ? "" : "; --fit-xy fits them");
     std::cout << fmt::format(
         "size: model {} bytes, data {} bytes ({}-bit samples), compression ratio {:.2f}\n", model.bytes,
         data_bytes, data.bits == 8 ? 8 : 16, data_bytes / static_cast<double>(model.bytes));

@@ -72,16 +72,19 @@ PatchParameters::PatchParameters(const PatchShape& shape) : shape_(shape) {
                 count_ += p.support.size() - 1;
             }
         }
+    if (shape.positions) count_ += 2 * k * k;
 }
 
 std::vector<double> PatchParameters::initial(const HeightGrid& data) const {
-    const std::size_t k = shape_.controls, n = shape_.split, m = k - 1;
+    const std::size_t k = shape_.controls, n = shape_.split;
     std::vector<double> x(count_, 0.0);
-    for (std::size_t r = 0; r < k; ++r)
-        for (std::size_t c = 0; c < k; ++c)
-            x[k * r + c] =
-                sample_data(data, static_cast<double>(c) / static_cast<double>(m) * (data.width - 1),
-                            static_cast<double>(r) / static_cast<double>(m) * (data.height - 1));
+    if (shape_.positions)
+        for (std::size_t q = 0; q < k * k; ++q) {
+            x[position_first() + q] = regular_position(1, q, data);
+            x[position_first() + k * k + q] = regular_position(2, q, data);
+        }
+    for (std::size_t q = 0; q < k * k; ++q)
+        x[q] = sample_data(data, control(x, 1, q, data), control(x, 2, q, data));
     // The linear weights of a position between its two control points (the first of them is free).
     auto frac_part = [&](std::size_t a) { return static_cast<double>(a % n) / static_cast<double>(n); };
     const std::size_t g = grid_side();
@@ -100,6 +103,22 @@ std::vector<double> PatchParameters::initial(const HeightGrid& data) const {
             }
         }
     return x;
+}
+
+double PatchParameters::control(const std::vector<double>& params, std::size_t coordinate, std::size_t q,
+                                const HeightGrid& data) const {
+    const std::size_t k = shape_.controls;
+    if (coordinate == 0) return params[q];
+    if (shape_.positions) return params[position_first() + (coordinate - 1) * k * k + q];
+    return regular_position(coordinate, q, data);
+}
+
+double PatchParameters::regular_position(std::size_t coordinate, std::size_t q,
+                                         const HeightGrid& data) const {
+    const std::size_t k = shape_.controls;
+    const std::size_t index = coordinate == 1 ? q % k : q / k;
+    const std::size_t samples = coordinate == 1 ? data.width : data.height;
+    return static_cast<double>(index) / static_cast<double>(k - 1) * static_cast<double>(samples - 1);
 }
 
 namespace {
@@ -186,12 +205,12 @@ PatchEvaluator::PatchEvaluator(const PatchParameters& layout, const HeightGrid& 
                 contributions_[fill[samples_[i].vertex[c]]++] = {i, samples_[i].weight[c]};
 }
 
-void PatchEvaluator::vertices(
-    const std::vector<double>& params, std::vector<double>& value,
-    const std::function<void(std::size_t vertex, const double* gradient)>* on_gradient) const {
+void PatchEvaluator::vertices(const std::vector<double>& params, std::vector<double>& value,
+                              const GradientSink* on_gradient) const {
     const auto& shape = layout_.shape();
     const std::size_t k = shape.controls, kk = k * k, n = shape.split, m = k - 1, g = layout_.grid_side();
-    const std::size_t count = layout_.count();
+    const std::size_t count = layout_.count(), coordinates = layout_.coordinate_count();
+    const std::size_t vertex_count = addresses_.size();
     const std::vector<double> lambda = layout_.face_weights(params);
     const auto& points = layout_.face_points();
     // Column q = k r + c of sub-patch T(i + N j) is the grid point (m i + c, m j + r).
@@ -201,12 +220,19 @@ void PatchEvaluator::vertices(
             for (std::size_t r = 0; r < k; ++r)
                 for (std::size_t c = 0; c < k; ++c)
                     column_point[(i + n * j) * kk + k * r + c] = (m * i + c) + g * (m * j + r);
+    // The control points' coordinates (a row P of the projection) and where their parameters are.
+    std::vector<double> control(coordinates * kk);
+    std::vector<std::size_t> control_first(coordinates);
+    for (std::size_t c = 0; c < coordinates; ++c) {
+        for (std::size_t q = 0; q < kk; ++q) control[c * kk + q] = layout_.control(params, c, q, data_);
+        control_first[c] = c == 0 ? 0 : layout_.position_first() + (c - 1) * kk;
+    }
     const std::size_t levels = static_cast<std::size_t>(shape.depth);
-    value.assign(addresses_.size(), 0.0);
+    value.assign(vertex_count * coordinates, 0.0);
     std::vector<double> gradient(on_gradient ? count : 0);
     // cols[l]: T_(l+1) ... T_(p-1) lambda_last (cols[p-1] = lambda_last); rows[l]: P T_1 ... T_l.
     std::vector<double> cols(levels * kk), rows(levels * kk);
-    for (std::size_t v = 0; v < addresses_.size(); ++v) {
+    for (std::size_t v = 0; v < vertex_count; ++v) {
         const auto& address = addresses_[v];
         const std::size_t ops = address.size() - 1;
         const double* last = &lambda[address.back() * kk];
@@ -223,59 +249,75 @@ void PatchEvaluator::vertices(
                 for (std::size_t s : p.support) out[s] += w[s] * in[q];
             }
         }
-        double z = 0;
-        for (std::size_t q = 0; q < kk; ++q) z += params[q] * cols[q];
-        value[v] = z;
-        if (!on_gradient) continue;
-        double* grad = gradient.data();
-        std::fill(grad, grad + count, 0.0);
-        for (std::size_t q = 0; q < kk; ++q) grad[q] = cols[q]; // dz / d height
-        std::copy(params.begin(), params.begin() + static_cast<std::ptrdiff_t>(kk), rows.begin());
-        // d z / d lambda_point[s] = rows_(l-1)[s] * cols_(l+1)[q] for the point in column q of T_l; then
-        // through the free weights: d / d param[first + i] = d[s_i] - d[s_last].
-        auto accumulate = [&](const PatchParameters::Point& p, const double* row, double factor) {
-            const double last_d = row[p.support.back()] * factor;
-            for (std::size_t i = 0; i + 1 < p.support.size(); ++i)
-                grad[p.first + i] += row[p.support[i]] * factor - last_d;
-        };
-        for (std::size_t l = 0; l < ops; ++l) {
-            const std::size_t* column = &column_point[address[l] * kk];
-            const double* row = &rows[l * kk];
-            const double* next = &cols[(l + 1) * kk];
-            double* row_out = l + 1 < levels ? &rows[(l + 1) * kk] : nullptr;
-            for (std::size_t q = 0; q < kk; ++q) {
-                const auto& p = points[column[q]];
-                const double* w = &lambda[column[q] * kk];
-                if (next[q] != 0) accumulate(p, row, next[q]);
-                double dot = 0;
-                for (std::size_t s : p.support) dot += row[s] * w[s];
-                row_out[q] = dot;
+        for (std::size_t c = 0; c < coordinates; ++c) {
+            const double* row0 = &control[c * kk];
+            double z = 0;
+            for (std::size_t q = 0; q < kk; ++q) z += row0[q] * cols[q];
+            value[c * vertex_count + v] = z;
+            if (!on_gradient) continue;
+            double* grad = gradient.data();
+            std::fill(grad, grad + count, 0.0);
+            if (c == 0 || shape.positions) // d / d control coordinate
+                for (std::size_t q = 0; q < kk; ++q) grad[control_first[c] + q] = cols[q];
+            std::copy(row0, row0 + kk, rows.begin());
+            // d / d lambda_point[s] = rows_(l-1)[s] * cols_(l+1)[q] for the point in column q of T_l;
+            // then through the free weights: d / d param[first + i] = d[s_i] - d[s_last].
+            auto accumulate = [&](const PatchParameters::Point& p, const double* row, double factor) {
+                const double last_d = row[p.support.back()] * factor;
+                for (std::size_t i = 0; i + 1 < p.support.size(); ++i)
+                    grad[p.first + i] += row[p.support[i]] * factor - last_d;
+            };
+            for (std::size_t l = 0; l < ops; ++l) {
+                const std::size_t* column = &column_point[address[l] * kk];
+                const double* row = &rows[l * kk];
+                const double* next = &cols[(l + 1) * kk];
+                double* row_out = l + 1 < levels ? &rows[(l + 1) * kk] : nullptr;
+                for (std::size_t q = 0; q < kk; ++q) {
+                    const auto& p = points[column[q]];
+                    const double* w = &lambda[column[q] * kk];
+                    if (next[q] != 0) accumulate(p, row, next[q]);
+                    double dot = 0;
+                    for (std::size_t s : p.support) dot += row[s] * w[s];
+                    row_out[q] = dot;
+                }
             }
+            accumulate(points[address.back()], &rows[ops * kk], 1.0);
+            (*on_gradient)(v, c, grad);
         }
-        accumulate(points[address.back()], &rows[ops * kk], 1.0);
-        (*on_gradient)(v, grad);
     }
+}
+
+double PatchEvaluator::target(std::size_t coordinate, std::size_t s) const {
+    if (coordinate == 0) return data_.z[s];
+    return static_cast<double>(coordinate == 1 ? s % data_.width : s / data_.width);
+}
+
+void PatchEvaluator::residuals_from(const std::vector<double>& value, double* out) const {
+    const std::size_t vertex_count = addresses_.size(), sample_count = samples_.size();
+    for (std::size_t c = 0; c < layout_.coordinate_count(); ++c)
+        for (std::size_t s = 0; s < sample_count; ++s) {
+            const Sample& sm = samples_[s];
+            double f = 0;
+            for (int i = 0; i < 4; ++i) f += sm.weight[i] * value[c * vertex_count + sm.vertex[i]];
+            out[c * sample_count + s] = f - target(c, s);
+        }
 }
 
 void PatchEvaluator::residuals(const std::vector<double>& params, double* out) const {
     std::vector<double> value;
     vertices(params, value, nullptr);
-    for (std::size_t s = 0; s < samples_.size(); ++s) {
-        const Sample& sm = samples_[s];
-        double f = 0;
-        for (int c = 0; c < 4; ++c) f += sm.weight[c] * value[sm.vertex[c]];
-        out[s] = f - data_.z[s];
-    }
+    residuals_from(value, out);
 }
 
 void PatchEvaluator::jacobian(const std::vector<double>& params, double* residuals_out, double* jac) const {
     // Each vertex's gradient goes straight into the rows of the samples it weighs in (one row per
     // vertex when the samples are the tabulation's vertices, the paper's case).
-    const std::size_t count = layout_.count();
-    std::vector<char> started(samples_.size(), 0);
-    const std::function<void(std::size_t, const double*)> to_rows = [&](std::size_t v, const double* grad) {
+    const std::size_t count = layout_.count(), sample_count = samples_.size();
+    std::vector<char> started(residual_count(), 0);
+    const GradientSink to_rows = [&](std::size_t v, std::size_t coordinate, const double* grad) {
         for (std::size_t i = contribution_start_[v]; i < contribution_start_[v + 1]; ++i) {
-            const auto [s, w] = contributions_[i];
+            const auto [sample, w] = contributions_[i];
+            const std::size_t s = coordinate * sample_count + sample;
             double* row = jac + s * count;
             if (started[s])
                 for (std::size_t j = 0; j < count; ++j) row[j] += w * grad[j];
@@ -288,17 +330,13 @@ void PatchEvaluator::jacobian(const std::vector<double>& params, double* residua
     };
     std::vector<double> value;
     vertices(params, value, &to_rows);
-    for (std::size_t s = 0; s < samples_.size(); ++s) {
-        const Sample& sm = samples_[s];
-        double f = 0;
-        for (int c = 0; c < 4; ++c) f += sm.weight[c] * value[sm.vertex[c]];
-        residuals_out[s] = f - data_.z[s];
-    }
+    residuals_from(value, residuals_out);
 }
 
 std::vector<double> PatchEvaluator::approximation(const std::vector<double>& params) const {
-    std::vector<double> r(samples_.size());
+    std::vector<double> r(residual_count());
     residuals(params, r.data());
+    r.resize(samples_.size()); // the z residuals
     for (std::size_t s = 0; s < r.size(); ++s) r[s] += data_.z[s];
     return r;
 }
@@ -336,16 +374,26 @@ struct ResidualFunctor {
 };
 
 // Progress, and the stop at the target PSNR.
+// With positions the cost holds x, y residuals too: the PSNR is then of the heights at the current
+// parameters (which Ceres keeps up to date for it).
 class Progress : public ceres::IterationCallback {
 public:
-    Progress(const FitOptions& options, const HeightGrid& data, std::size_t samples, FitResult& result)
-        : options_(options), data_(data), samples_(static_cast<double>(samples)), result_(result),
+    Progress(const FitOptions& options, const HeightGrid& data, const PatchEvaluator& evaluator,
+             const std::vector<double>& params, FitResult& result)
+        : options_(options), data_(data), evaluator_(evaluator), params_(params),
+          samples_(static_cast<double>(data.z.size())), result_(result),
           start_(std::chrono::steady_clock::now()) {}
     ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
         // An unsuccessful step reports the cost it tried; the fit stays at the best so far.
         if (summary.iteration == 0 || (summary.step_is_successful && summary.cost < best_cost_))
             best_cost_ = summary.cost;
-        const double mse = 2 * best_cost_ / samples_;
+        double mse = 2 * best_cost_ / samples_;
+        if (evaluator_.layout().shape().positions) {
+            const std::vector<double> z = evaluator_.approximation(params_);
+            mse = 0;
+            for (std::size_t s = 0; s < z.size(); ++s) mse += (z[s] - data_.z[s]) * (z[s] - data_.z[s]);
+            mse /= samples_;
+        }
         const double psnr = mse > 0 ? 10.0 * std::log10(data_.peak * data_.peak / mse)
                                     : std::numeric_limits<double>::infinity();
         const double seconds =
@@ -362,6 +410,8 @@ public:
 private:
     const FitOptions& options_;
     const HeightGrid& data_;
+    const PatchEvaluator& evaluator_;
+    const std::vector<double>& params_;
     double samples_;
     FitResult& result_;
     double best_cost_ = std::numeric_limits<double>::infinity();
@@ -389,7 +439,7 @@ FitResult fit_patch(const HeightGrid& data, const FitOptions& options) {
         cost->SetNumResiduals(static_cast<int>(evaluator.residual_count()));
         problem.AddResidualBlock(cost, nullptr, result.params.data());
     }
-    for (std::size_t i = layout.height_count(); i < layout.count(); ++i) {
+    for (std::size_t i = layout.height_count(); i < layout.position_first(); ++i) {
         problem.SetParameterLowerBound(result.params.data(), static_cast<int>(i), options.weight_range[0]);
         problem.SetParameterUpperBound(result.params.data(), static_cast<int>(i), options.weight_range[1]);
     }
@@ -404,7 +454,8 @@ FitResult fit_patch(const HeightGrid& data, const FitOptions& options) {
     solver.gradient_tolerance = 1e-14;
     solver.logging_type = ceres::SILENT;
     solver.num_threads = 1;
-    Progress progress(options, data, evaluator.residual_count(), result);
+    solver.update_state_every_iteration = options.shape.positions;
+    Progress progress(options, data, evaluator, result.params, result);
     solver.callbacks.push_back(&progress);
     ceres::Solver::Summary summary;
     ceres::Solve(solver, &problem, &summary);
@@ -426,6 +477,30 @@ FitResult fit_patch(const HeightGrid& data, const FitOptions& options) {
         summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::NO_CONVERGENCE;
     result.converged = finite && (options.target_psnr > 0 ? result.seconds_to_target >= 0 : stopped_well);
     return result;
+}
+
+Drift position_drift(const PatchParameters& layout, const std::vector<double>& params,
+                     const HeightGrid& data) {
+    PatchShape shape = layout.shape();
+    shape.positions = true;
+    const PatchParameters with_positions(shape);
+    std::vector<double> x(params.begin(),
+                          params.begin() + static_cast<std::ptrdiff_t>(layout.position_first()));
+    for (std::size_t c = 1; c <= 2; ++c)
+        for (std::size_t q = 0; q < layout.height_count(); ++q)
+            x.push_back(layout.control(params, c, q, data));
+    const PatchEvaluator evaluator(with_positions, data);
+    std::vector<double> r(evaluator.residual_count());
+    evaluator.residuals(x, r.data());
+    const std::size_t samples = data.z.size();
+    Drift d;
+    for (std::size_t s = 0; s < samples; ++s) {
+        const double squared = r[samples + s] * r[samples + s] + r[2 * samples + s] * r[2 * samples + s];
+        d.max = std::max(d.max, std::sqrt(squared));
+        d.rms += squared;
+    }
+    d.rms = std::sqrt(d.rms / static_cast<double>(samples));
+    return d;
 }
 
 namespace {
@@ -469,9 +544,11 @@ QuantizedModel quantize(const PatchParameters& layout, const std::vector<double>
                 step > 0 ? lo + step * std::clamp(std::round((params[i] - lo) / step), 0.0, levels) : lo;
     };
     quantize_group(0, heights);
-    quantize_group(heights, params.size());
+    quantize_group(heights, layout.position_first());
+    quantize_group(layout.position_first(), params.size()); // the control points' x, y, if fitted
     for (double& v : q.params) v = static_cast<double>(units(v)) / decimal_scale;
-    q.bytes = (params.size() * static_cast<std::size_t>(bits) + 7) / 8 + 2 * 2 * 4;
+    const std::size_t groups = layout.shape().positions ? 3 : 2; // each stores its range: two floats
+    q.bytes = (params.size() * static_cast<std::size_t>(bits) + 7) / 8 + groups * 2 * 4;
     return q;
 }
 
@@ -529,15 +606,10 @@ std::string write_bcifs(const PatchParameters& layout, const std::vector<double>
     out += fmt::format(
         "    }}\n    topology e = edge(v) split {};\n    topology f = quad(e) split {} x {};\n", n, n, n);
     out += "    project = controls(";
-    for (std::size_t r = 0; r < k; ++r)
-        for (std::size_t c = 0; c < k; ++c) {
-            const double x =
-                static_cast<double>(c) / static_cast<double>(m) * static_cast<double>(data.width - 1);
-            const double y =
-                static_cast<double>(r) / static_cast<double>(m) * static_cast<double>(data.height - 1);
-            out += fmt::format("{}({}, {}, {})", r + c ? ",\n                       " : "", decimal(units(x)),
-                               decimal(units(y)), decimal(units(params[k * r + c])));
-        }
+    for (std::size_t q = 0; q < kk; ++q)
+        out += fmt::format("{}({}, {}, {})", q ? ",\n                       " : "",
+                           decimal(units(layout.control(params, 1, q, data))),
+                           decimal(units(layout.control(params, 2, q, data))), decimal(units(params[q])));
     out += ");\n}\n";
     return out;
 }

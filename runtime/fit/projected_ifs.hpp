@@ -9,7 +9,11 @@
 // subspaces corresponding to parts of the control grid": the point at grid position (a, b) sits at a / N,
 // b / N in control-grid units and weighs only the control points of the cell (or side, or corner) it
 // falls in. The parameters are those weights (less one per point: barycentric) and the heights of the
-// control points; the control points' x, y stay on the regular grid.
+// control points; with `positions`, also the control points' x and y ("the coefficients of the operators
+// and the coordinates of the control grid", sec. 3.3), the residuals then being the components of the
+// 3-D distance ||Q_ij - F(i / N^p, j / N^p)|| of sec. 4.2 (x, y in sample units, z in data units: the
+// written model's own coordinates). Without them the control points stay on the regular grid and only
+// heights are compared (the model as an image: z at each parameter point).
 //
 // The fitted surface is tabulated as in sec. 2.4: F(i / N^p, j / N^p) = P T_s1 ... T_sp e00, a vertex
 // per (i, j) in 0 .. N^p; the data are compared with the tabulation bilinearly interpolated at their
@@ -34,6 +38,7 @@ struct PatchShape {
     std::size_t split = 3;    // N: sub-patches per side
     std::size_t controls = 4; // k: control points per side
     int depth = 4;            // p: tabulation depth, (N^p + 1)^2 vertices
+    bool positions = false;   // fit the control points' x, y too (3-D residuals)
 };
 
 // The parameter layout of a shape: which weights the parameters are.
@@ -44,7 +49,11 @@ public:
     const PatchShape& shape() const { return shape_; }
     std::size_t count() const { return count_; }
     std::size_t height_count() const { return shape_.controls * shape_.controls; }
-    std::size_t weight_count() const { return count_ - height_count(); }
+    // Parameters: heights [0, height_count()), weights [height_count(), position_first()), then (with
+    // positions) the control points' x and y, height_count() each.
+    std::size_t position_first() const { return count_ - (shape_.positions ? 2 * height_count() : 0); }
+    std::size_t weight_count() const { return position_first() - height_count(); }
+    std::size_t coordinate_count() const { return shape_.positions ? 3 : 1; }          // z, then x, y
     std::size_t grid_side() const { return (shape_.controls - 1) * shape_.split + 1; } // mN + 1
 
     // A barycentric point of the grid: the control points it weighs (face indices k * row + column, or
@@ -58,14 +67,22 @@ public:
     const std::vector<Point>& face_points() const { return face_; } // (mN + 1)^2, index a + (mN + 1) b
 
     // The weights that make every operator the bilinear subdivision of the control grid (the attractor
-    // is the bilinear interpolation of the control points), and heights sampled from the data.
+    // is the bilinear interpolation of the control points), heights sampled from the data, and the
+    // control points on the regular grid over the samples.
     std::vector<double> initial(const HeightGrid& data) const;
+
+    // Control point q's coordinate (0: z, 1: x, 2: y; without positions x, y on the regular grid).
+    double control(const std::vector<double>& params, std::size_t coordinate, std::size_t q,
+                   const HeightGrid& data) const;
 
     // The dense face points lambda (grid_side^2 points of k^2 weights) and edge points (grid_side of k).
     std::vector<double> face_weights(const std::vector<double>& params) const;
     std::vector<double> edge_weights(const std::vector<double>& params) const;
 
 private:
+    // Control point q's x (coordinate 1) or y (2) on the regular grid over the samples.
+    double regular_position(std::size_t coordinate, std::size_t q, const HeightGrid& data) const;
+
     PatchShape shape_;
     std::size_t count_ = 0;
     std::vector<Point> edge_, face_;
@@ -76,21 +93,30 @@ class PatchEvaluator {
 public:
     PatchEvaluator(const PatchParameters& layout, const HeightGrid& data);
 
-    std::size_t residual_count() const { return data_.z.size(); }
+    // A residual per sample and coordinate: the z residuals of every sample, then (with positions) the
+    // x residuals, then the y residuals.
+    std::size_t residual_count() const { return data_.z.size() * layout_.coordinate_count(); }
     const PatchParameters& layout() const { return layout_; }
 
-    // Residuals F(x_s, y_s) - z_s at every sample.
+    // Residuals F(x_s, y_s) - (x_s, y_s, z_s) at every sample.
     void residuals(const std::vector<double>& params, double* out) const;
     // Residuals and their Jacobian, residual_count() x count(), row-major (one row a residual).
     void jacobian(const std::vector<double>& params, double* residuals_out, double* jacobian_row_major) const;
-    // The model's values at the samples.
+    // The model's heights at the samples.
     std::vector<double> approximation(const std::vector<double>& params) const;
 
 private:
-    // Vertex values; when on_gradient is given, each vertex's gradient (count() entries, valid only
-    // during the call) is handed to it as it is computed, so no vertex-by-parameter array is built.
+    // Vertex coordinates (value[coordinate * vertices + vertex]); when on_gradient is given, each
+    // vertex coordinate's gradient (count() entries, valid only during the call) is handed to it as it
+    // is computed, so no vertex-by-parameter array is built.
+    using GradientSink =
+        std::function<void(std::size_t vertex, std::size_t coordinate, const double* gradient)>;
     void vertices(const std::vector<double>& params, std::vector<double>& value,
-                  const std::function<void(std::size_t vertex, const double* gradient)>* on_gradient) const;
+                  const GradientSink* on_gradient) const;
+    // Residuals from the vertex coordinates.
+    void residuals_from(const std::vector<double>& value, double* out) const;
+    // Sample s's value in a coordinate (z: the data; x, y: its position in sample units).
+    double target(std::size_t coordinate, std::size_t s) const;
     struct Sample {
         std::size_t vertex[4];
         double weight[4];
@@ -139,9 +165,18 @@ struct FitResult {
 
 FitResult fit_patch(const HeightGrid& data, const FitOptions& options);
 
-// Parameters rounded as a coded model stores them: each of the two groups (heights, weights) quantised
-// to `bits` bits between its minimum and maximum (kept as two 32-bit floats each), then rounded to the
-// decimals the written model holds (9 places; the dependent weight of each point then sums exactly).
+// Where the model's vertices lie against the samples' x, y (sample units): without fitted positions the
+// fit bends the operators freely, and the written surface's vertices drift off the sample grid.
+struct Drift {
+    double max = 0, rms = 0;
+};
+Drift position_drift(const PatchParameters& layout, const std::vector<double>& params,
+                     const HeightGrid& data);
+
+// Parameters rounded as a coded model stores them: each group (heights, weights, and the control points'
+// x, y when fitted) quantised to `bits` bits between its minimum and maximum (kept as two 32-bit floats
+// each), then rounded to the decimals the written model holds (9 places; the dependent weight of each point
+// then sums exactly).
 struct QuantizedModel {
     std::vector<double> params;
     std::size_t bytes = 0; // parameters x bits / 8, plus the ranges
@@ -150,8 +185,8 @@ QuantizedModel quantize(const PatchParameters& layout, const std::vector<double>
 
 // The model as a bcifs of the language: cells v, e (bary(k)), f (bary(k^2)), the topology of an edge
 // and of a quad patch, the operators written with exact decimals (so the compiler's exact check of the
-// barycentric sums, incidence and adjacency holds), and the control points at x = column / m *
-// (width - 1), y = row / m * (height - 1), z the fitted heights. `comment` goes at the top.
+// barycentric sums, incidence and adjacency holds), and the control points at their fitted x, y (or
+// x = column / m * (width - 1), y = row / m * (height - 1)), z the fitted heights. `comment` goes at the top.
 std::string write_bcifs(const PatchParameters& layout, const std::vector<double>& params,
                         const HeightGrid& data, const std::string& name, const std::string& comment);
 

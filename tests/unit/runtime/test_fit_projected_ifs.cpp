@@ -45,11 +45,16 @@ std::string temp_file(const std::string& name, const std::string& text) {
 TEST_CASE("fit: the exact Jacobian matches central differences", "[fit]") {
     // Data of another size than the tabulation (the samples interpolate vertices bilinearly), and data
     // on the tabulation's vertices (each sample one vertex).
-    for (const auto& [shape, width, height] :
-         {std::tuple{small_shape(3, 4, 2), std::size_t{13}, std::size_t{14}},
-          std::tuple{small_shape(2, 3, 3), std::size_t{9}, std::size_t{10}},
-          std::tuple{small_shape(3, 3, 2), std::size_t{10}, std::size_t{11}},
-          std::tuple{small_shape(3, 4, 2), std::size_t{10}, std::size_t{10}}}) {
+    // With positions, the x and y residuals' rows too.
+    for (const auto& [base_shape, width, height, positions] :
+         {std::tuple{small_shape(3, 4, 2), std::size_t{13}, std::size_t{14}, false},
+          std::tuple{small_shape(2, 3, 3), std::size_t{9}, std::size_t{10}, false},
+          std::tuple{small_shape(3, 3, 2), std::size_t{10}, std::size_t{11}, false},
+          std::tuple{small_shape(3, 4, 2), std::size_t{10}, std::size_t{10}, false},
+          std::tuple{small_shape(3, 4, 2), std::size_t{13}, std::size_t{14}, true},
+          std::tuple{small_shape(2, 3, 3), std::size_t{9}, std::size_t{9}, true}}) {
+        PatchShape shape = base_shape;
+        shape.positions = positions;
         const HeightGrid data = elliptic_paraboloid(width, height);
         const PatchParameters layout(shape);
         const PatchEvaluator evaluator(layout, data);
@@ -71,7 +76,8 @@ TEST_CASE("fit: the exact Jacobian matches central differences", "[fit]") {
                                             ? std::numeric_limits<double>::infinity()
                                             : std::abs((plus[s] - minus[s]) / (2 * h) - jac[s * n + j]));
         }
-        INFO("split " << shape.split << ", controls " << shape.controls << ", depth " << shape.depth);
+        INFO("split " << shape.split << ", controls " << shape.controls << ", depth " << shape.depth
+                      << ", positions " << shape.positions);
         CHECK(worst < 1e-7);
     }
 }
@@ -178,4 +184,91 @@ TEST_CASE("fit: malformed data is located", "[fit]") {
     CHECK(g.height == 2);
     CHECK(g.at(1, 1) == 4);
     CHECK(g.peak == 3);
+}
+
+namespace {
+
+// Heights with detail finer than the control grid: a fit bends the operators, and with them the
+// vertices' x and y.
+HeightGrid rough_surface(std::size_t side) {
+    HeightGrid data = elliptic_paraboloid(side, side);
+    for (std::size_t y = 0; y < side; ++y)
+        for (std::size_t x = 0; x < side; ++x)
+            data.z[y * side + x] += 0.08 * std::sin(0.9 * static_cast<double>(x)) *
+                                    std::cos(0.7 * static_cast<double>(y) + 0.4 * static_cast<double>(x));
+    return data;
+}
+
+double squares(const std::vector<double>& r, std::size_t from, std::size_t to) {
+    double sum = 0;
+    for (std::size_t i = from; i < to; ++i) sum += r[i] * r[i];
+    return sum;
+}
+
+} // namespace
+
+TEST_CASE("fit: control points' positions fitted with 3-D residuals, written as fitted", "[fit]") {
+    const std::size_t side = 28, samples = side * side;
+    const HeightGrid data = rough_surface(side);
+    FitOptions heights_only;
+    heights_only.shape = small_shape(3, 4, 3);
+    heights_only.max_iterations = 12;
+    FitOptions with_positions = heights_only;
+    with_positions.shape.positions = true;
+    const PatchParameters layout0(heights_only.shape), layout(with_positions.shape);
+    REQUIRE(layout.count() == layout0.count() + 2 * 16);
+    REQUIRE(layout.position_first() == layout0.count());
+    const PatchEvaluator evaluator(layout, data);
+    REQUIRE(evaluator.residual_count() == 3 * samples);
+    // The start has the control points on the regular grid: no x, y residual.
+    std::vector<double> r(evaluator.residual_count());
+    evaluator.residuals(layout.initial(data), r.data());
+    CHECK(squares(r, samples, 3 * samples) < 1e-20);
+
+    const FitResult fit0 = fit_patch(data, heights_only);
+    const FitResult fit = fit_patch(data, with_positions);
+    REQUIRE(fit0.converged);
+    REQUIRE(fit.converged);
+    // The heights-only fit, seen in 3-D (its control points where they stay): its bent operators move
+    // the vertices off the samples' x, y. The 3-D fit has a smaller 3-D distance, and less drift.
+    std::vector<double> as_3d = fit0.params;
+    for (std::size_t c = 1; c <= 2; ++c)
+        for (std::size_t q = 0; q < 16; ++q) as_3d.push_back(layout0.control(fit0.params, c, q, data));
+    std::vector<double> r0(evaluator.residual_count());
+    evaluator.residuals(as_3d, r0.data());
+    evaluator.residuals(fit.params, r.data());
+    INFO("heights-only: z " << squares(r0, 0, samples) << ", x y " << squares(r0, samples, 3 * samples)
+                            << "; 3-D: z " << squares(r, 0, samples) << ", x y "
+                            << squares(r, samples, 3 * samples));
+    CHECK(squares(r0, samples, 3 * samples) > 1e-3);
+    CHECK(squares(r, 0, 3 * samples) < 0.9 * squares(r0, 0, 3 * samples));
+    CHECK(squares(r, samples, 3 * samples) < 0.5 * squares(r0, samples, 3 * samples));
+    bool moved = false;
+    for (std::size_t q = 0; q < 16; ++q)
+        moved = moved || std::abs(fit.params[layout.position_first() + q] -
+                                  layout0.control(fit0.params, 1, q, data)) > 1e-6;
+    CHECK(moved);
+
+    // Stored with a third range (x, y), and written with the fitted x, y: the language's tessellation of
+    // the model is the fitted surface in all three coordinates.
+    const QuantizedModel model = quantize(layout, fit.params, 16);
+    CHECK(model.bytes == (layout.count() * 16 + 7) / 8 + 24);
+    const std::string text = write_bcifs(layout, model.params, data, "fitted", "a 3-D fit");
+    const auto c = driver::compile_source("fitted.frac", text);
+    REQUIRE(c->ok());
+    const ir::Automaton& a = c->module.automata.front().automaton;
+    const rt::Tessellation t = rt::tessellate(a, rt::infer_layout(a), 3);
+    REQUIRE(t.side_s == side);
+    REQUIRE(t.side_t == side);
+    evaluator.residuals(model.params, r.data());
+    double worst = 0;
+    for (std::size_t i = 0; i < side; ++i)
+        for (std::size_t j = 0; j < side; ++j) {
+            const std::size_t s = i * side + j;
+            const auto& v = t.vertices[i * t.side_t + j];
+            worst = std::max({worst, std::abs(v[2] - (r[s] + data.z[s])),
+                              std::abs(v[0] - (r[samples + s] + static_cast<double>(j))),
+                              std::abs(v[1] - (r[2 * samples + s] + static_cast<double>(i)))});
+        }
+    CHECK(worst < 1e-9);
 }
