@@ -191,24 +191,30 @@ int run_fit_curve(const FitCurveOptions& o) {
                                      shown(p.map.c[0][0]), shown(p.map.e[0]));
     }
     if (o.output.empty()) return 0;
-    if (!f.every_domain_whole() && !f.domains_are_unions_of_ranges(1e-9 * (f.t1 - f.t0)))
-        throw RunError(
-            "the PFIF has domains that are not unions of its ranges, which no ifs or cifs expresses; "
-            "fit an RFIF (--method rfif) to write a model; nothing written");
+    const bool partitioned = !f.every_domain_whole() && !f.domains_are_unions_of_ranges(1e-9 * (f.t1 - f.t0));
     const std::string name = model_name(o);
     const std::string text = rt::fit::to_frac(
         f, name,
         fmt::format(
             "// frac fit --method {} of {} ({} samples): max error {:.4g}, mean squared error {:.4g}\n",
             o.method, std::filesystem::path(o.file).filename().string(), data.size(), error.max_error,
-            error.mse));
+            error.mse),
+        o.method == "hough" ? 0 : static_cast<std::size_t>(o.grid));
     // The model must compile, its contraction proven, before it replaces anything.
     const auto compiled = driver::compile_source(o.output, text);
     if (!compiled->ok())
-        throw RunError("the fitted model does not compile (nothing written):\n" +
-                       compiled->diags.render(compiled->sources));
+        throw RunError(
+            fmt::format("the fitted model does not compile (nothing written){}:\n{}",
+                        partitioned ? "; a PFIF whose domains do not close up is no automaton: fit an RFIF "
+                                      "(--method rfif), or a PFIF on another --grid"
+                                    : "",
+                        compiled->diags.render(compiled->sources)));
     support::write_file_atomically(o.output, text, "model");
-    std::cout << fmt::format("wrote {} ({} {})\n", o.output, f.every_domain_whole() ? "ifs" : "cifs", name);
+    std::cout << fmt::format("wrote {} ({} {})\n", o.output,
+                             f.every_domain_whole() ? "ifs"
+                             : partitioned          ? "fif"
+                                                    : "cifs",
+                             name);
     return 0;
 }
 

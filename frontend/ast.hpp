@@ -172,14 +172,23 @@ inline bool is_unknown(const Expr& e) {
 // Piece i is the shear T_i (eq. 1; eq. 8/9 for a curve (t, x, y)) with T_i(P_j) = P_(i-1) and T_i(P_k) = P_i
 // for its domain (j, k) (default (0, N): a FIF; k < j: the "reflected" constraints; other domains: an
 // RFIF). frontend/fif.hpp expands it into the states and arcs of a cifs after parsing.
+// A piece of a partitioned FIF (seed 001 sec. 2.3): the shear `map` (a homogeneous matrix over (t, x) or
+// (t, x, y)) takes the graph over its domain [from, to] onto the graph over its range.
+struct FifPiece {
+    Location loc; // the `piece` keyword
+    ExprPtr from, to, map;
+};
+
 struct FifDecl {
-    std::vector<ExprPtr> points; // tuples (t, x) or (t, x, y)
-    std::string data;            // a CSV file of rows t, x[, y], relative to the model, instead of points
+    std::vector<FifPiece> pieces; // a PFIF, instead of points and scalings
+    std::vector<ExprPtr> points;  // tuples (t, x) or (t, x, y)
+    std::string data;             // a CSV file of rows t, x[, y], relative to the model, instead of points
     Location points_loc, data_loc, scale_loc, domains_loc;
     std::vector<ExprPtr> scales;
     std::vector<std::array<int, 2>> domains; // point indices (j, k), one per piece, or empty
     std::vector<Location> domain_locs;
     std::vector<ExprPtr> values; // set by the expansion: every point as a tuple (t, x[, y])
+    bool malformed = false;      // a statement failed to parse (reported): not expanded
 };
 
 struct AutomatonDecl {

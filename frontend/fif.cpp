@@ -1,12 +1,16 @@
 #include "frontend/fif.hpp"
 
 #include "frontend/loader.hpp"
+#include "numeric/rational.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <deque>
+#include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -95,6 +99,16 @@ public:
     Expansion(Item& it, Diagnostics& d) : it_(it), a_(*it.automaton), f_(*a_.fif), d_(d) {}
 
     void run(const std::filesystem::path& dir, std::size_t max_file_bytes) {
+        if (f_.malformed) return; // its parse errors are reported; what is left would only add noise
+        if (!f_.pieces.empty()) {
+            if (!f_.points.empty() || !f_.data.empty() || !f_.scales.empty() || !f_.domains.empty()) {
+                d_.error(f_.pieces.front().loc,
+                         "a fif of pieces (a PFIF) has its maps in them: no points, data, scale or domains");
+                return;
+            }
+            partitioned();
+            return;
+        }
         if (!f_.data.empty() && !f_.points.empty()) {
             d_.error(f_.data_loc, "a fif takes its points from 'points' or from 'data', not both");
             return;
@@ -400,6 +414,301 @@ private:
             }
         }
     }
+
+    // ---- A partitioned FIF (seed 001 sec. 2.3): F = U_i T_i(F[alpha_i, beta_i]) ----
+    //
+    // The graph over an interval I is the union, over the ranges R_j that I overlaps, of T_j applied to
+    // the graph over the preimage of I n R_j, a part of D_j: a state per interval, starting from the
+    // whole, until no new interval appears (exactly, in rationals). The states are finite when the
+    // domains' ends close up under the maps' inverses (ends on a grid the maps keep, as data fits have);
+    // otherwise the count passes max_fif_pieces and the PFIF is refused as no finite automaton.
+
+    using Q = num::Rational;
+    static constexpr std::size_t max_pfif_bits = 1024; // numerator and denominator of an interval's end
+
+    // An exact number written with + - * / and literals; nullopt for anything else.
+    static std::optional<Q> exact(const Expr& e) {
+        try {
+            switch (e.kind) {
+            case ExprKind::number: return Q::parse_decimal(e.text);
+            case ExprKind::unary: {
+                auto v = exact(*e.kids[0]);
+                if (!v || (e.op != Tok::minus && e.op != Tok::plus)) return std::nullopt;
+                return e.op == Tok::minus ? -*v : *v;
+            }
+            case ExprKind::binary: {
+                auto a = exact(*e.kids[0]), b = exact(*e.kids[1]);
+                if (!a || !b) return std::nullopt;
+                switch (e.op) {
+                case Tok::plus: return *a + *b;
+                case Tok::minus: return *a - *b;
+                case Tok::star: return *a * *b;
+                case Tok::slash:
+                    if (b->is_zero()) return std::nullopt;
+                    return *a / *b;
+                default: return std::nullopt;
+                }
+            }
+            default: return std::nullopt;
+            }
+        } catch (const std::exception&) {
+            return std::nullopt;
+        }
+    }
+
+    struct Piece {
+        Q from, to, a, d;                   // domain [from, to]; t -> a t + d
+        Q range_lo, range_hi;               // its image
+        std::vector<std::vector<double>> m; // the matrix, for the chords
+    };
+
+    bool read_pieces(std::vector<Piece>& pieces) {
+        if (f_.pieces.size() > max_fif_pieces) {
+            d_.error(f_.pieces[max_fif_pieces].loc,
+                     fmt::format("a fif of {} pieces is more than the limit of {}", f_.pieces.size(),
+                                 max_fif_pieces));
+            return false;
+        }
+        std::size_t size = 0;
+        for (std::size_t i = 0; i < f_.pieces.size(); ++i) {
+            const FifPiece& fp = f_.pieces[i];
+            Piece p;
+            const auto from = exact(*fp.from), to = exact(*fp.to);
+            if (!from || !to) {
+                d_.error((from ? fp.to : fp.from)->loc,
+                         "a piece's domain ends are exact numbers (decimals, fractions, + - * /), so its "
+                         "pieces can be found exactly");
+                return false;
+            }
+            if (!(*from < *to)) {
+                d_.error(fp.from->loc, fmt::format("the domain [{}, {}] of piece {} is empty: alpha < beta",
+                                                   from->to_double(), to->to_double(), i + 1));
+                return false;
+            }
+            const Expr& m = *fp.map;
+            const std::size_t n = m.kind == ExprKind::matrix ? m.kids.size() : 0;
+            if ((n != 3 && n != 4) || m.kids.front()->kids.size() != n || (size && n != size)) {
+                d_.error(m.loc, size ? fmt::format("piece {}'s map is not {} x {} as the first piece's",
+                                                   i + 1, size, size)
+                                     : "a piece's map is a homogeneous matrix, 3 x 3 over (t, x) or 4 x 4 "
+                                       "over (t, x, y): [[a, 0, d], [b, c, e], [0, 0, 1]]");
+                return false;
+            }
+            size = n;
+            p.m.assign(n, std::vector<double>(n));
+            for (std::size_t r = 0; r < n; ++r)
+                for (std::size_t c = 0; c < n; ++c) {
+                    const Expr& entry = *m.kids[r]->kids[c];
+                    const auto v = exact(entry);
+                    if (!v) {
+                        d_.error(
+                            entry.loc,
+                            "a piece's map has exact numbers for entries (decimals, fractions, + - * /)");
+                        return false;
+                    }
+                    const bool t_row_zero = r == 0 && c != 0 && c + 1 != n, last_row = r + 1 == n;
+                    if ((t_row_zero || last_row) && *v != Q(last_row && c + 1 == n ? 1 : 0)) {
+                        d_.error(entry.loc,
+                                 last_row
+                                     ? "the last row of a piece's map is [0, ..., 0, 1]"
+                                     : "a piece's map takes t to a t + d: its first row is [a, 0, ..., d]");
+                        return false;
+                    }
+                    p.m[r][c] = v->to_double();
+                    if (r == 0 && c == 0) p.a = *v;
+                    if (r == 0 && c + 1 == n) p.d = *v;
+                }
+            if (!(abs(p.a) < Q(1)) || p.a.is_zero()) {
+                d_.error(m.kids[0]->kids[0]->loc,
+                         fmt::format("piece {} does not contract (eq. 2): |a| = {:.6g}, its range must be "
+                                     "shorter than its domain and not a point",
+                                     i + 1, abs(p.a).to_double()));
+                return false;
+            }
+            p.from = *from;
+            p.to = *to;
+            const Q u = p.a * p.from + p.d, v = p.a * p.to + p.d;
+            p.range_lo = std::min(u, v);
+            p.range_hi = std::max(u, v);
+            pieces.push_back(std::move(p));
+        }
+        // The ranges tile [t0, tN]; every domain lies in it.
+        std::vector<std::size_t> order(pieces.size());
+        for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+        std::sort(order.begin(), order.end(),
+                  [&](std::size_t x, std::size_t y) { return pieces[x].range_lo < pieces[y].range_lo; });
+        for (std::size_t k = 1; k < order.size(); ++k) {
+            const Piece &prev = pieces[order[k - 1]], &p = pieces[order[k]];
+            if (p.range_lo != prev.range_hi) {
+                d_.error(
+                    f_.pieces[order[k]].loc,
+                    fmt::format("the ranges of a PFIF tile an interval: piece {}'s range [{:.6g}, {:.6g}] "
+                                "{} piece {}'s [{:.6g}, {:.6g}]",
+                                order[k] + 1, p.range_lo.to_double(), p.range_hi.to_double(),
+                                p.range_lo < prev.range_hi ? "overlaps" : "leaves a gap after",
+                                order[k - 1] + 1, prev.range_lo.to_double(), prev.range_hi.to_double()));
+                return false;
+            }
+        }
+        by_range_ = order;
+        t0_ = pieces[order.front()].range_lo;
+        tn_ = pieces[order.back()].range_hi;
+        for (std::size_t i = 0; i < pieces.size(); ++i)
+            if (pieces[i].from < t0_ || pieces[i].to > tn_) {
+                d_.error(
+                    f_.pieces[i].from->loc,
+                    fmt::format("piece {}'s domain [{:.6g}, {:.6g}] leaves the graph's interval [{:.6g}, "
+                                "{:.6g}] (the union of the ranges)",
+                                i + 1, pieces[i].from.to_double(), pieces[i].to.to_double(), t0_.to_double(),
+                                tn_.to_double()));
+                return false;
+            }
+        return true;
+    }
+
+    // The graph's value at t approached from the right (side > 0) or the left: the descent
+    // X(t) = b s + C X(s) + e, s the preimage of t in the piece whose range holds t on that side,
+    // summed until the product of the C's is negligible (the scalings contract).
+    std::vector<double> limit_value(const std::vector<Piece>& pieces, double t, int side) const {
+        const std::size_t dims = pieces.front().m.size() - 2;
+        std::vector<double> value(dims, 0.0), product(dims * dims, 0.0);
+        for (std::size_t r = 0; r < dims; ++r) product[r * dims + r] = 1;
+        const double lo = t0_.to_double(), hi = tn_.to_double();
+        for (int step = 0; step < 100000; ++step) {
+            if (t <= lo) side = 1;
+            if (t >= hi) side = -1;
+            const Piece* piece = nullptr;
+            for (const Piece& p : pieces) {
+                const double r0 = p.range_lo.to_double(), r1 = p.range_hi.to_double();
+                if (side > 0 ? (r0 <= t && t < r1) : (r0 < t && t <= r1)) piece = &p;
+            }
+            if (!piece) break;
+            const auto& m = piece->m;
+            const std::size_t last = dims + 1;
+            const double s = (t - m[0][last]) / m[0][0];
+            double largest = 0;
+            std::vector<double> next(dims * dims, 0.0);
+            for (std::size_t r = 0; r < dims; ++r) {
+                for (std::size_t k = 0; k < dims; ++k)
+                    value[r] += product[r * dims + k] * (m[1 + k][0] * s + m[1 + k][last]);
+                for (std::size_t c = 0; c < dims; ++c) {
+                    for (std::size_t k = 0; k < dims; ++k)
+                        next[r * dims + c] += product[r * dims + k] * m[1 + k][1 + c];
+                    largest = std::max(largest, std::abs(next[r * dims + c]));
+                }
+            }
+            product = std::move(next);
+            if (m[0][0] < 0) side = -side;
+            t = s;
+            if (largest < 1e-18) break;
+        }
+        return value;
+    }
+
+    ExprPtr literal(double v, Location loc) const {
+        ExprPtr n = number(fmt::format("{:.17g}", std::abs(v)), loc);
+        if (!(v < 0)) return n;
+        auto neg = make(ExprKind::unary, loc);
+        neg->op = Tok::minus;
+        neg->kids.push_back(std::move(n));
+        return neg;
+    }
+
+    // segment((u, X(u+)), (v, X(v-))): the chord of a state's graph, for the leaves of evaluation trees
+    // (the ends to double precision: drawing only).
+    ExprPtr partitioned_chord(const std::vector<Piece>& pieces, const Q& u, const Q& v) const {
+        auto e = make(ExprKind::call, it_.loc);
+        e->text = "segment";
+        for (const auto& [t, side] : {std::pair{u, 1}, std::pair{v, -1}}) {
+            auto p = make(ExprKind::tuple, it_.loc);
+            p->kids.push_back(literal(t.to_double(), it_.loc));
+            for (double x : limit_value(pieces, t.to_double(), side)) p->kids.push_back(literal(x, it_.loc));
+            e->args.push_back({"", it_.loc, std::move(p)});
+        }
+        return e;
+    }
+
+    void partitioned() {
+        std::vector<Piece> pieces;
+        if (!read_pieces(pieces)) return;
+        const SpaceDecl space{false, static_cast<int>(pieces.front().m.size()) - 1, it_.loc};
+        std::map<std::pair<Q, Q>, std::size_t> index;
+        std::vector<std::pair<Q, Q>> intervals;
+        const auto state_name = [&](std::size_t k) { return k == 0 ? it_.name : fmt::format("g{}", k); };
+        // A finite closure keeps its ends on a grid: ends of ever more bits mean it does not close up
+        // (and would only cost time), so they are refused like too many intervals.
+        const auto bits = [](const Q& x) {
+            return mpz_sizeinbase(x.value().get_num_mpz_t(), 2) +
+                   mpz_sizeinbase(x.value().get_den_mpz_t(), 2);
+        };
+        const auto state = [&](const Q& u, const Q& v) -> std::optional<std::size_t> {
+            const auto [at, added] = index.try_emplace({u, v}, intervals.size());
+            if (added) {
+                if (intervals.size() >= max_fif_pieces || bits(u) > max_pfif_bits || bits(v) > max_pfif_bits)
+                    return std::nullopt;
+                intervals.push_back({u, v});
+            }
+            return at->second;
+        };
+        if (!state(t0_, tn_)) {
+            d_.error(f_.pieces.front().loc,
+                     fmt::format("the interval of PFIF '{}' has ends of more than {} bits", it_.name,
+                                 max_pfif_bits));
+            return;
+        }
+        std::vector<ArcDecl> arcs;
+        for (std::size_t k = 0; k < intervals.size(); ++k) {
+            const auto [u, v] = intervals[k];
+            // The ranges tile: those that overlap (u, v) are consecutive from the last one starting at
+            // or before u.
+            auto first = std::upper_bound(by_range_.begin(), by_range_.end(), u,
+                                          [&](const Q& x, std::size_t j) { return x < pieces[j].range_lo; });
+            if (first != by_range_.begin()) --first;
+            for (auto at = first; at != by_range_.end() && pieces[*at].range_lo < v; ++at) {
+                const std::size_t j = *at;
+                const Piece& p = pieces[j];
+                const Q lo = std::max(u, p.range_lo), hi = std::min(v, p.range_hi);
+                if (!(lo < hi)) continue;
+                const Q s = (lo - p.d) / p.a, e = (hi - p.d) / p.a;
+                const auto to = state(std::min(s, e), std::max(s, e));
+                if (!to) {
+                    d_.error(
+                        f_.pieces.front().loc,
+                        fmt::format("the domains of PFIF '{}' cut its graph into more than {} intervals, or "
+                                    "at ends of more than {} bits: it is no finite automaton (the ends of "
+                                    "its domains do not close up under the maps; put them on a grid the "
+                                    "maps keep)",
+                                    it_.name, max_fif_pieces, max_pfif_bits));
+                    return;
+                }
+                if (arcs.size() >= max_fif_arcs) {
+                    d_.error(f_.pieces.front().loc,
+                             fmt::format("PFIF '{}' needs more than {} arcs, the limit of a fif", it_.name,
+                                         max_fif_arcs));
+                    return;
+                }
+                ArcDecl arc;
+                arc.from = state_name(k);
+                arc.to = state_name(*to);
+                arc.label = fmt::format("T{}", j + 1);
+                arc.loc = arc.from_loc = arc.to_loc = f_.pieces[j].loc;
+                arc.op = copy(*f_.pieces[j].map);
+                arcs.push_back(std::move(arc));
+            }
+        }
+        for (std::size_t k = 0; k < intervals.size(); ++k)
+            a_.states.push_back({state_name(k),
+                                 it_.loc,
+                                 space,
+                                 partitioned_chord(pieces, intervals[k].first, intervals[k].second),
+                                 {},
+                                 {},
+                                 {}});
+        a_.arcs = std::move(arcs);
+    }
+
+    Q t0_, tn_;                         // a PFIF's interval
+    std::vector<std::size_t> by_range_; // its pieces in the order of their ranges
 
     Item& it_;
     AutomatonDecl& a_;

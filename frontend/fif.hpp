@@ -10,7 +10,11 @@
 // with X the value (x, or (x, y) for a curve) and C the vertical scaling (c, diag(cx, cy) for eq. 8, a
 // 2 x 2 matrix for eq. 9). Every domain (0, N) (the default): one state, a FIF. Other domains: an RFIF,
 // a state per range r_i whose arcs lead to the ranges its domain covers, and an initial state that is
-// their union. Contraction is proven by the metric of eq. 2 when lowering (lower.cpp).
+// their union. A fif of `piece [alpha, beta] MATRIX` statements is a PFIF (sec. 2.3): the graph over an
+// interval is the union of the pieces' maps of the graphs over the preimages of its parts in their
+// ranges, so the states are the intervals generated from the whole one, exactly in rationals, until none
+// is new (at most max_fif_pieces: a PFIF whose domain ends do not close up is no finite automaton).
+// Contraction is proven by the metric of eq. 2 when lowering (lower.cpp).
 #pragma once
 
 #include "frontend/ast.hpp"

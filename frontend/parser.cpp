@@ -210,7 +210,8 @@ private:
         return it;
     }
 
-    // fif NAME { points P0, ..., PN; | data "FILE"; scale C1, ..., CN; [domains (j, k), ...;] } (ast.hpp)
+    // fif NAME { points P0, ..., PN; | data "FILE"; scale C1, ..., CN; [domains (j, k), ...;] }, or a PFIF:
+    // fif NAME { piece [ALPHA, BETA] MATRIX; ... } (ast.hpp)
     Item fif(Item it) {
         take();
         it.kind = ItemKind::automaton;
@@ -222,8 +223,18 @@ private:
         expect(Tok::lbrace, "to open the fif");
         while (!at(Tok::rbrace) && !at(Tok::end)) {
             try {
-                const Token& word = expect(Tok::ident, "(points, data, scale or domains) in a fif");
-                if (word.text == "points") {
+                const Token& word = expect(Tok::ident, "(points, data, scale, domains or piece) in a fif");
+                if (word.text == "piece") {
+                    FifPiece piece;
+                    piece.loc = word.loc;
+                    expect(Tok::lbracket, "to open the piece's domain [alpha, beta]");
+                    piece.from = expr();
+                    expect(Tok::comma, "between the ends of the piece's domain");
+                    piece.to = expr();
+                    expect(Tok::rbracket, "to close the piece's domain");
+                    piece.map = expr();
+                    f.pieces.push_back(std::move(piece));
+                } else if (word.text == "points") {
                     f.points_loc = word.loc;
                     do f.points.push_back(expr());
                     while (accept(Tok::comma));
@@ -247,13 +258,14 @@ private:
                     } while (accept(Tok::comma));
                 } else {
                     throw CompileError(word.loc,
-                                       fmt::format("expected points, data, scale or domains in a fif, "
+                                       fmt::format("expected points, data, scale, domains or piece in a fif, "
                                                    "found '{}'",
                                                    word.text));
                 }
                 expect(Tok::semicolon, "after the fif statement");
             } catch (const CompileError& e) {
                 diags_.error(e.loc, e.what());
+                f.malformed = true;
                 while (!at(Tok::semicolon) && !at(Tok::rbrace) && !at(Tok::end)) take();
                 accept(Tok::semicolon);
             }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <limits>
+#include <numeric>
+#include <optional>
 
 namespace frac::rt::fit {
 
@@ -190,27 +192,69 @@ void quantize8(FractalFunction& f, const Samples& data) {
     }
 }
 
-std::string to_frac(const FractalFunction& f, const std::string& name, const std::string& comment) {
-    auto matrix = [&](const Shear& s) {
-        const std::string d = number(s.d);
+std::string to_frac(const FractalFunction& f, const std::string& name, const std::string& comment,
+                    std::size_t grid) {
+    // The matrix of s, its t part (a, d) written as given.
+    auto written = [&](const Shear& s, const std::string& a, const std::string& d) {
         if (!f.curve)
-            return fmt::format("[[{}, 0, {}], [{}, {}, {}], [0, 0, 1]]", number(s.a), d, number(s.b[0]),
+            return fmt::format("[[{}, 0, {}], [{}, {}, {}], [0, 0, 1]]", a, d, number(s.b[0]),
                                number(s.c[0][0]), number(s.e[0]));
-        return fmt::format("[[{}, 0, 0, {}], [{}, {}, {}, {}], [{}, {}, {}, {}], [0, 0, 0, 1]]", number(s.a),
-                           d, number(s.b[0]), number(s.c[0][0]), number(s.c[0][1]), number(s.e[0]),
+        return fmt::format("[[{}, 0, 0, {}], [{}, {}, {}, {}], [{}, {}, {}, {}], [0, 0, 0, 1]]", a, d,
+                           number(s.b[0]), number(s.c[0][0]), number(s.c[0][1]), number(s.e[0]),
                            number(s.b[1]), number(s.c[1][0]), number(s.c[1][1]), number(s.e[1]));
     };
+    auto matrix = [&](const Shear& s) { return written(s, number(s.a), number(s.d)); };
     const char* space = f.curve ? "R3" : "R2";
     std::string out = comment;
+    if (!f.every_domain_whole() && !f.domains_are_unions_of_ranges(1e-9 * (f.t1 - f.t0))) {
+        // A PFIF: ends on the grid as exact fractions of it, the t part as the exact map of the domain
+        // onto the range (orientation kept), so that the compiler finds the ranges tiling exactly.
+        const double span = f.t1 - f.t0;
+        const bool unit = f.t0 == 0 && f.t1 == 1;
+        auto cells = [&](double v) -> std::optional<long long> { // v's grid index, if it is on the grid
+            const double k = grid ? (v - f.t0) / span * static_cast<double>(grid) : 0.5;
+            if (!grid || std::abs(k - std::round(k)) > 1e-9) return std::nullopt;
+            return std::llround(k);
+        };
+        auto fraction = [](long long n, long long d) {
+            const long long g = std::gcd(n, d) * (d < 0 ? -1 : 1);
+            return d / g == 1 ? fmt::format("{}", n / g) : fmt::format("{}/{}", n / g, d / g);
+        };
+        auto end = [&](double v) {
+            const auto k = cells(v);
+            if (!k) return number(v);
+            const auto g = static_cast<long long>(grid);
+            if (unit) return fraction(*k, g);
+            return fmt::format("({} + {} * ({} - {}))", number(f.t0), fraction(*k, g), number(f.t1),
+                               number(f.t0));
+        };
+        out += fmt::format("fif {} {{\n", name);
+        for (const Piece& p : f.pieces) {
+            const bool forward = p.map.a > 0;
+            const double from = forward ? p.lo : p.hi, to = forward ? p.hi : p.lo; // images of alpha, beta
+            const auto ka = cells(p.alpha), kb = cells(p.beta), kf = cells(from), kt = cells(to);
+            std::string a, d;
+            if (unit && ka && kb && kf && kt) { // a = (to - from) / (beta - alpha), d = from - a alpha
+                const auto g = static_cast<long long>(grid), width = *kb - *ka;
+                a = fraction(*kt - *kf, width);
+                d = fraction(*kf * width - (*kt - *kf) * *ka, g * width);
+            } else {
+                a = fmt::format("({} - {}) / ({} - {})", end(to), end(from), end(p.beta), end(p.alpha));
+                d = fmt::format("{} - {} * {}", end(from), a, end(p.alpha));
+            }
+            out += fmt::format("    piece [{}, {}] {};\n", end(p.alpha), end(p.beta), written(p.map, a, d));
+        }
+        return out + "}\n";
+    }
+    // An RFIF: the state r_i is the graph over range i; its arcs lead to the states of the ranges that make
+    // up its domain. The initial state is the whole graph, the union of the ranges.
+    const double tolerance = 1e-9 * (f.t1 - f.t0);
     if (f.every_domain_whole()) {
         out += fmt::format("ifs {} in {} {{\n", name, space);
         for (std::size_t i = 0; i < f.pieces.size(); ++i)
             out += fmt::format("    T{} = {};\n", i + 1, matrix(f.pieces[i].map));
         return out + "}\n";
     }
-    // An RFIF: the state r_i is the graph over range i; its arcs lead to the states of the ranges that make
-    // up its domain. The initial state is the whole graph, the union of the ranges.
-    const double tolerance = 1e-9 * (f.t1 - f.t0);
     out += fmt::format("cifs {} {{\n    state graph", name);
     for (std::size_t i = 0; i < f.pieces.size(); ++i) out += fmt::format(", r{}", i + 1);
     out += fmt::format(" in {};\n", space);

@@ -70,8 +70,12 @@ FitError measure(const FractalFunction& f, const Samples& data);
 void quantize8(FractalFunction& f, const Samples& data);
 
 // The model as Frac source: an `ifs` over R2 (a FIF) or a `cifs` with a state per range (an RFIF, a curve
-// over R3 with coordinates (t, x, y)). Requires every domain to be a union of ranges.
-std::string to_frac(const FractalFunction& f, const std::string& name, const std::string& comment);
+// over R3 with coordinates (t, x, y)), or else a `fif` of pieces (a PFIF), its interval ends written
+// exactly as points of a grid of `grid` cells over [t0, t1] where they lie on one (0: no grid), and each
+// map's t part as the exact map of its domain onto its range, so the ranges tile exactly. Whether the
+// PFIF's intervals close up into a finite automaton is the compiler's to decide.
+std::string to_frac(const FractalFunction& f, const std::string& name, const std::string& comment,
+                    std::size_t grid = 0);
 
 // The samples of f at `count` uniform values of t over [t0, t1].
 Samples sample(const FractalFunction& f, std::size_t count);

@@ -31,4 +31,10 @@ make_hostile_catalogue() {
       printf '; scale 0.5; domains '; seq 1 10000 | sed 's/.*/(0, 10000)/' | paste -sd, - | tr -d '\n'
       printf ';}\n'; } > fif_arcs_1e8.frac
     { printf 'import "/tmp";\nshape s(x, y) = x;\n'; } > import_directory.frac
+    { printf 'fif many {\n'; seq 0 10000 | sed 's|.*|piece [0, 1] [[1/10001, 0, &/10001], [0, 0.5, 0], [0, 0, 1]];|'
+      printf '}\n'; } > pfif_pieces_1e4.frac
+    # A PFIF whose cuts never close up (ratios 999999/1000000 and 999998/1000000): the interval closure
+    # runs into its limit with ever longer rationals.
+    { printf 'fif endless {\n piece [0, 500000/999999] [[999999/1000000, 0, 0], [0, 0.5, 0], [0, 0, 1]];\n'
+      printf ' piece [1/7, 1/7 + 500000/999998] [[999998/1000000, 0, 1/2 - 999998/1000000 / 7], [0, 0.5, 0], [0, 0, 1]];\n}\n'; } > pfif_endless.frac
 }

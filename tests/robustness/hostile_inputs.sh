@@ -51,6 +51,8 @@ expect_error import_dev_zero "cannot import '/dev/zero': not a regular file"
 expect_error import_directory "is a directory"
 expect_error fif_data_1e5 "a fif of more than 10000 pieces"
 expect_error fif_arcs_1e8 "more than the limit of 100000 arcs"
+expect_error pfif_pieces_1e4 "a fif of 10001 pieces is more than the limit of 10000"
+expect_error pfif_endless "cut its graph into more than 10000 intervals, or at ends of more than 1024 bits: it is no finite automaton"
 
 # At the limits, evaluated: a sum of 200,000 terms (one function LLVM would take hours and gigabytes to
 # compile) is interpreted, never a blow-up.

@@ -8,7 +8,9 @@
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace frac;
@@ -104,4 +106,56 @@ fif k { points (0, 0, 0), (1/2, 1, 1), (1, 2, 0); scale [[3/10, 1/10], [-1/10, 3
     check_pieces(*c, "s", points, {{0, 2}, {0, 2}}, {{{q(3, 10), q(0)}, {q(0), q(1, 2)}}});
     check_pieces(*c, "k", points, {{0, 2}, {0, 2}},
                  {{{q(3, 10), q(1, 10)}, {q(-1, 10), q(3, 10)}}, {{q(3, 10), q(0)}, {q(1, 5), q(2, 5)}}});
+}
+
+TEST_CASE("fif: a PFIF's states are intervals each tiled by its arcs' images (eq. 7)", "[fif]") {
+    // Seed 001 Table 3 with fractions, and a PFIF whose domains end between the ranges' ends.
+    auto c = test::compile_ok(R"(
+fif top {
+    piece [5/18, 2/3] [[-1/3, 0, 2/9],   [0, -1/2, 3/8],   [0, 0, 1]];
+    piece [1/6, 1/2]  [[1/3, 0, 2/27],   [0, -1/2, 9/16],  [0, 0, 1]];
+    piece [1/6, 4/9]  [[1/3, 0, 5/27],   [0, 1/2, 1/16],   [0, 0, 1]];
+    piece [0, 1]      [[1/3, 0, 1/3],    [0, 1/2, 1/4],    [0, 0, 1]];
+    piece [1/6, 4/9]  [[-1/3, 0, 22/27], [0, -1/2, 15/16], [0, 0, 1]];
+    piece [1/6, 1/2]  [[-1/3, 0, 25/27], [0, 1/2, 7/16],   [0, 0, 1]];
+    piece [5/18, 2/3] [[1/3, 0, 7/9],    [0, 1/2, 5/8],    [0, 0, 1]];
+}
+fif between {
+    piece [1/6, 5/6] [[1/2, 0, -1/12], [0.3, 0.4, 0],     [0, 0, 1]];
+    piece [0, 2/3]   [[1/2, 0, 1/3],   [-0.2, -0.5, 0.5], [0, 0, 1]];
+    piece [1/3, 1]   [[1/2, 0, 1/2],   [0.1, 0.3, 0.2],   [0, 0, 1]];
+}
+)");
+    for (const auto& [name, states] : {std::pair{"top", 8}, std::pair{"between", 6}}) {
+        INFO(name);
+        const ir::Automaton& a = c->module.find_automaton(name)->automaton;
+        REQUIRE(a.states.size() == static_cast<std::size_t>(states));
+        // A state's interval: the t of its chord's ends.
+        const auto interval = [&](std::size_t s) {
+            const auto& p = a.states[s].primitive.points;
+            return std::pair{p(0, 0), p(0, 1)};
+        };
+        for (std::size_t s = 0; s < a.states.size(); ++s) {
+            std::vector<std::pair<double, double>> images;
+            for (const ir::Arc& arc : a.arcs) {
+                if (arc.from != s) continue;
+                REQUIRE(arc.op.exact);
+                const auto [u, v] = interval(arc.to);
+                const double at = (*arc.op.exact)(0, 0).to_double(), d = (*arc.op.exact)(0, 2).to_double();
+                images.push_back(std::minmax(at * u + d, at * v + d));
+            }
+            std::sort(images.begin(), images.end());
+            const auto [u, v] = interval(s);
+            REQUIRE(!images.empty());
+            CHECK(images.front().first == Approx(u).margin(1e-15));
+            CHECK(images.back().second == Approx(v).margin(1e-15));
+            for (std::size_t k = 1; k < images.size(); ++k)
+                CHECK(images[k].first == Approx(images[k - 1].second).margin(1e-15));
+        }
+    }
+    // Table 3's graph runs from (0, 0) to (1, 1): f(0+) = -f(2/3-)/2 + 3/8 with f(2/3-) = f(1-)/2 + 1/4 and
+    // f(1-) = f(2/3-)/2 + 5/8, so f(2/3-) = 3/4, f(1-) = 1, f(0+) = 0; the chord of the whole joins them.
+    const auto& chord = c->module.find_automaton("top")->automaton.states[0].primitive.points;
+    CHECK(chord(1, 0) == Approx(0).margin(1e-12));
+    CHECK(chord(1, 1) == Approx(1).margin(1e-12));
 }
