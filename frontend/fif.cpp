@@ -11,6 +11,7 @@
 #include <deque>
 #include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -628,6 +629,42 @@ private:
         return e;
     }
 
+    // The points the dimension query reads (lower.cpp fif_points, runtime fif_box_dimension): the graph's
+    // ends, and where the graph is no segment, its one-sided value farthest off the chord, at a cut
+    // point inside. If every one-sided value at every cut (state and range ends) lies on the chord, each
+    // piece maps the chord's part over its domain onto the chord's part over its range, so the graph is
+    // the chord (its deviation is scaled by |c| < 1 at each step): D = 1, and only the ends are given.
+    void shape_points(const std::vector<Piece>& pieces, const std::vector<std::pair<Q, Q>>& intervals) {
+        std::set<Q> cuts;
+        for (const auto& [u, v] : intervals) cuts.insert({u, v});
+        for (const Piece& p : pieces) cuts.insert({p.range_lo, p.range_hi});
+        const double t0 = t0_.to_double(), tn = tn_.to_double();
+        const std::vector<double> x0 = limit_value(pieces, t0, 1), xn = limit_value(pieces, tn, -1);
+        const auto point = [&](double t, const std::vector<double>& x) {
+            auto tuple = make(ExprKind::tuple, it_.loc);
+            tuple->kids.push_back(literal(t, it_.loc));
+            for (double c : x) tuple->kids.push_back(literal(c, it_.loc));
+            return tuple;
+        };
+        double worst = 0, worst_t = 0;
+        std::vector<double> worst_x;
+        const double scale = std::abs(tn - t0) + std::abs(xn[0] - x0[0]);
+        for (const Q& cut : cuts) {
+            const double t = cut.to_double();
+            if (!(t > t0 && t < tn)) continue;
+            for (const int side : {-1, 1}) {
+                const std::vector<double> x = limit_value(pieces, t, side);
+                double off = 0;
+                for (std::size_t r = 0; r < x.size(); ++r)
+                    off = std::max(off, std::abs((tn - t0) * (x[r] - x0[r]) - (xn[r] - x0[r]) * (t - t0)));
+                if (off > worst) worst = off, worst_t = t, worst_x = x;
+            }
+        }
+        f_.values.push_back(point(t0, x0));
+        if (worst > 1e-12 * scale * scale) f_.values.push_back(point(worst_t, worst_x));
+        f_.values.push_back(point(tn, xn));
+    }
+
     void partitioned() {
         std::vector<Piece> pieces;
         if (!read_pieces(pieces)) return;
@@ -696,6 +733,7 @@ private:
                 arcs.push_back(std::move(arc));
             }
         }
+        shape_points(pieces, intervals);
         for (std::size_t k = 0; k < intervals.size(); ++k)
             a_.states.push_back({state_name(k),
                                  it_.loc,
