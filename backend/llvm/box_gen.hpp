@@ -86,8 +86,9 @@ public:
         }
     }
 
-    // FRAC_JIT_EXACT_CALLS=1 in the environment: sqrt, sin, cos and exp call the numeric core (correctly
-    // rounded, bit for bit the interpreter's) instead of the inline kernels; for benchmarks and tests.
+    // FRAC_JIT_EXACT_CALLS=1 in the environment: sqrt, sin, cos, exp, tan and log call the numeric core
+    // (correctly rounded, bit for bit the interpreter's) instead of the inline kernels; for benchmarks and
+    // tests.
     static bool exact_calls_requested() {
         const char* v = std::getenv("FRAC_JIT_EXACT_CALLS");
         return v && std::string(v) == "1";
@@ -346,6 +347,11 @@ private:
     SlotState op_exp(const SlotState& a);
     // An approximation of exp(x) for |x| <= 700, relative error below 2^-46.
     Value* exp_value(Value* x);
+    // tan from the enclosures of sin and cos at the ends, between poles (box_kernels.cpp).
+    SlotState op_tan(const SlotState& a);
+    SlotState op_log(const SlotState& a);
+    // An approximation of log(x) for a positive normal x, error below 2^-47 |log x| (0 at x = 1).
+    Value* log_value(Value* x);
     SlotState op_powi(const SlotState& a, std::int64_t n);
     SlotState op_minmax(const SlotState& a, const SlotState& b, bool is_min);
     SlotState op_round(const SlotState& a, bool up);
@@ -393,7 +399,8 @@ private:
     SlotState emit_series(const Instr& ins);
 
     bool avx512_;
-    bool fast_kernels_; // inline sqrt, sin, cos, exp (FRAC_JIT_EXACT_CALLS=1: the numeric core's calls)
+    bool fast_kernels_; // inline sqrt, sin, cos, exp, tan, log (FRAC_JIT_EXACT_CALLS=1: the numeric core's
+                        // calls)
     Type *vt_, *mt_, *vi64_;
     Value* scratch_in_ = nullptr;
     Value* scratch_n_ = nullptr;

@@ -1,6 +1,7 @@
 // Interval kernels of box code computed inline in vector form instead of calling the numeric core lane
 // by lane (see box_gen.hpp): sqrt with directed rounding, sin and cos by range reduction and
-// polynomials with a proven error bound, exp likewise. Lanes a kernel cannot handle call the core.
+// polynomials with a proven error bound, exp and log likewise, tan from the sin and cos enclosures. Lanes
+// a kernel cannot handle call the core.
 #include "backend/llvm/box_gen.hpp"
 
 #include <iterator>
@@ -64,6 +65,19 @@ constexpr double exp_coeffs[] = {0x1.93974a8c07c9dp-37,
                                  0x1p+0};
 // |v - exp(x)| <= exp_rel_bound v (docs/design.md, "Vector interval kernels").
 constexpr double exp_rel_bound = 0x1p-46;
+
+// log: fast lanes have 2^-1022 <= lo <= hi < inf (positive normal doubles). ln 2 = H + L with H =
+// 0x1.62e42feep-1 (its last 21 bits zero, so e H is exact for |e| <= 1024) and L = RN(ln 2 - H),
+// |ln 2 - H - L| < 2^-80.
+constexpr double log_fast_min = 0x1p-1022;
+constexpr double ln2_hi = 0x1.62e42feep-1;
+constexpr double ln2_lo = 0x1.a39ef35793c76p-33;
+constexpr double sqrt2 = 0x1.6a09e667f3bcdp+0;
+// log m = 2 s P(s^2), P(z) = sum z^n / (2n + 1): coefficients RN(1/(2n + 1)), n = 10 .. 0.
+constexpr double log_coeffs[] = {1.0 / 21, 1.0 / 19, 1.0 / 17, 1.0 / 15, 1.0 / 13, 1.0 / 11,
+                                 1.0 / 9,  1.0 / 7,  1.0 / 5,  1.0 / 3,  1.0};
+// |v - log(x)| <= log_rel_bound |v| + abs_floor (docs/design.md, "Vector interval kernels").
+constexpr double log_rel_bound = 0x1p-47;
 
 } // namespace
 
@@ -148,6 +162,73 @@ SlotState BoxGen::op_sincos(const SlotState& a, bool is_cos) {
     lo = sel(b_.CreateOr(whole, hits(max_at + 2.0)), cst(-1.0), lo);
     hi = sel(b_.CreateOr(whole, hits(max_at)), cst(1.0), hi);
     return result(with_fallback(fast, {lo, hi}, is_cos ? Op::Cos : Op::Sin, {&a}), a.f.maybe_empty);
+}
+
+SlotState BoxGen::op_tan(const SlotState& a) {
+    const IV& x = a.v;
+    Value* fast = land(le(x.lo, x.hi),
+                       land(le(fabs(x.lo), cst(trig_fast_limit)), le(fabs(x.hi), cst(trig_fast_limit))));
+    // As numeric/interval.cpp: t encloses x / (pi/2), poles at odd t; a t-range of 2 or more holds one.
+    // Between poles tan is increasing.
+    Value* t_lo = mul_down(x.lo, sel(ge(x.lo, cst(0.0)), cst(two_over_pi_lo), cst(two_over_pi_hi)));
+    Value* t_hi = mul(x.hi, sel(ge(x.hi, cst(0.0)), cst(two_over_pi_hi), cst(two_over_pi_lo)));
+    Value* n = ceil(t_lo); // the least integer >= t_lo: an odd one within [t_lo, t_hi] is a pole
+    Value* odd = sel(eq(sub(n, mul(cst(2.0), floor(mul(n, cst(0.5))))), cst(0.0)), add(n, cst(1.0)), n);
+    Value* pole = lor(ge(sub(t_hi, t_lo), cst(2.0)), le(odd, t_hi));
+    // tan at an end lies in S / C, S and C the proven enclosures of sin and cos there; C holds no 0 away
+    // from the poles, except within its bound of one, where the lane calls the core.
+    auto quotient = [&](Value* at) {
+        const IV s = sincos_point(at, 0), c = sincos_point(at, 1);
+        Value* positive = gt(c.lo, cst(0.0));
+        // With C < 0, S / C = (-S) / (-C).
+        const IV num{sel(positive, s.lo, neg(s.hi)), sel(positive, s.hi, neg(s.lo))};
+        const IV den{sel(positive, c.lo, neg(c.hi)), sel(positive, c.hi, neg(c.lo))};
+        const IV q{div_down(num.lo, sel(ge(num.lo, cst(0.0)), den.hi, den.lo)),
+                   div(num.hi, sel(ge(num.hi, cst(0.0)), den.lo, den.hi))};
+        return std::pair{q, lor(positive, lt(c.hi, cst(0.0)))};
+    };
+    const auto [at_lo, lo_ok] = quotient(x.lo);
+    const auto [at_hi, hi_ok] = quotient(x.hi);
+    const IV r{sel(pole, cst(-inf), at_lo.lo), sel(pole, cst(inf), at_hi.hi)};
+    fast = land(fast, lor(pole, land(lo_ok, hi_ok)));
+    return result(with_fallback(fast, r, Op::Tan, {&a}), a.f.maybe_empty);
+}
+
+Value* BoxGen::log_value(Value* x) {
+    // x = 2^e m with m in [sqrt(2)/2, sqrt(2)); log x = e ln 2 + log m, log m = 2 atanh(s) with
+    // s = (m - 1) / (m + 1), |s| <= 0.1716 (docs/design.md, "Vector interval kernels").
+    Value* bits = b_.CreateBitCast(x, vi64_);
+    Value* e =
+        b_.CreateSIToFP(b_.CreateSub(b_.CreateLShr(bits, 52), llvm::ConstantInt::get(vi64_, 1023)), vt_);
+    Value* m =
+        b_.CreateBitCast(b_.CreateOr(b_.CreateAnd(bits, llvm::ConstantInt::get(vi64_, 0x000FFFFFFFFFFFFFULL)),
+                                     llvm::ConstantInt::get(vi64_, 0x3FF0000000000000ULL)),
+                         vt_);
+    Value* big = gt(m, cst(sqrt2));
+    m = sel(big, mul(m, cst(0.5)), m); // exact
+    e = sel(big, add(e, cst(1.0)), e);
+    Value* f = sub(m, cst(1.0)); // exact (Sterbenz)
+    Value* s = div(f, add(f, cst(2.0)));
+    Value* z = mul(s, s);
+    Value* p = cst(log_coeffs[0]);
+    for (std::size_t i = 1; i < std::size(log_coeffs); ++i) p = fma(p, z, cst(log_coeffs[i]));
+    Value* log_m = mul(add(s, s), p);
+    return fma(e, cst(ln2_hi), fma(e, cst(ln2_lo), log_m)); // e H is exact
+}
+
+SlotState BoxGen::op_log(const SlotState& a) {
+    const IV& x = a.v;
+    // numeric/interval.cpp: empty when a is empty or a.hi <= 0, a lower bound <= 0 gives -inf. The fast
+    // lanes: both ends positive normal doubles.
+    Value* fast = land(le(x.lo, x.hi), land(ge(x.lo, cst(log_fast_min)), lt(x.hi, cst(inf))));
+    Value* at_lo = log_value(x.lo);
+    Value* at_hi = log_value(x.hi);
+    // log 1 = 0 is exact (s = 0, e = 0) and kept thin.
+    auto err = [&](Value* at, Value* arg) {
+        return sel(eq(arg, cst(1.0)), cst(0.0), add(mul(fabs(at), cst(log_rel_bound)), cst(abs_floor)));
+    };
+    const IV r{sub_down(at_lo, err(at_lo, x.lo)), add(at_hi, err(at_hi, x.hi))};
+    return result(with_fallback(fast, r, Op::Log, {&a}), true); // log of x <= 0 is empty
 }
 
 } // namespace frac::jit::box

@@ -243,12 +243,16 @@ SlotState BoxGen::emit_op(const Instr& ins) {
     case Op::Cos:
         if (fast_kernels_) return op_sincos(in(0), ins.op == Op::Cos);
         return call_core(ins.op, 0, {&in(0)}, in(0).f.maybe_empty);
-    case Op::Pow:
-    case Op::Log: return call_core(ins.op, 0, {&in(0), &in(ir::arity(ins.op) > 1 ? 1 : 0)}, true);
+    case Op::Log:
+        if (fast_kernels_ && ir::arity(ins.op) == 1) return op_log(in(0));
+        [[fallthrough]];
+    case Op::Pow: return call_core(ins.op, 0, {&in(0), &in(ir::arity(ins.op) > 1 ? 1 : 0)}, true);
     case Op::Exp:
         if (fast_kernels_) return op_exp(in(0));
         return call_core(ins.op, 0, {&in(0)}, in(0).f.maybe_empty);
-    case Op::Tan: return call_core(ins.op, 0, {&in(0)}, in(0).f.maybe_empty);
+    case Op::Tan:
+        if (fast_kernels_) return op_tan(in(0));
+        return call_core(ins.op, 0, {&in(0)}, in(0).f.maybe_empty);
     case Op::Atan2: return call_core(ins.op, 0, {&in(0), &in(1)}, in(0).f.maybe_empty || in(1).f.maybe_empty);
     case Op::External: return call_external(ins.imm, in(0), in(1), in(2));
     case Op::Lt:

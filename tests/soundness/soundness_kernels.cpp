@@ -1,4 +1,4 @@
-// Soundness and tightness of the JIT's inline interval kernels (sqrt, sin, cos, exp;
+// Soundness and tightness of the JIT's inline interval kernels (sqrt, sin, cos, exp, tan, log;
 // backend/llvm/box_kernels.cpp) against the exact range computed with MPFR: for random intervals of many
 // widths and magnitudes, and the hard cases (near multiples of pi/2, huge arguments, tiny and thin intervals,
 // zeros, infinities, NaN and empty intervals), the JIT's enclosure [L, H] of f over [lo, hi] must satisfy L
@@ -59,9 +59,14 @@ public:
         case 10: return unbounded();
         case 11: return not_an_interval();
         case 12: return around(signed_magnitude(-1074, -300)); // tiny and subnormal
-        case 13: // around the limits of the fast paths: 2^30 (sin, cos), 700 (exp; overflow past 709.78)
-            return pick(2) ? around(signed_magnitude(25, 35))
-                           : around((pick(2) ? 1 : -1) * (690 + 60 * unit()));
+        case 13: // around the limits of the fast paths: 2^30 (sin, cos, tan), 700 (exp; overflow past
+                 // 709.78), 1 and the normal range's ends (log)
+            switch (pick(4)) {
+            case 0: return around(signed_magnitude(25, 35));
+            case 1: return around((pick(2) ? 1 : -1) * (690 + 60 * unit()));
+            case 2: return around(1 + signed_magnitude(-60, -1));
+            default: return around(std::ldexp(1.0 + unit(), pick(2) ? -1022 - pick(4) : 1020 + pick(4)));
+            }
         default: return uniform(-10, 10);
         }
     }
@@ -168,6 +173,11 @@ ExactRange increasing_range(MpfrFunction f, double lo, double hi) {
     return e;
 }
 
+ExactRange log_range(double lo, double hi) {
+    if (hi <= 0) return {false};                              // the result must be empty
+    return increasing_range(mpfr_log, std::max(lo, 0.0), hi); // log 0 = -inf
+}
+
 ExactRange sqrt_range(double lo, double hi) {
     if (hi < 0) return {false}; // the result must be empty
     return increasing_range(mpfr_sqrt, std::max(lo, 0.0), hi);
@@ -253,6 +263,25 @@ ExactRange sincos_range(double lo, double hi, bool is_cos) {
     return e;
 }
 
+ExactRange tan_range(double lo, double hi) {
+    if (std::isinf(lo) || std::isinf(hi)) {
+        if (lo == hi) return {false}; // {+inf} or {-inf}: no value
+        return {true, -inf, inf};
+    }
+    // Poles at odd t = x / (pi/2); between them tan increases.
+    mpz_t n_lo, n_hi;
+    mpz_init(n_lo);
+    mpz_init(n_hi);
+    quadrant_bound(n_lo, lo, true);
+    quadrant_bound(n_hi, hi, false);
+    const bool pole =
+        mpz_cmp(n_lo, n_hi) <= 0 && (holds_residue(n_lo, n_hi, 1) || holds_residue(n_lo, n_hi, 3));
+    mpz_clear(n_lo);
+    mpz_clear(n_hi);
+    if (pole) return {true, -inf, inf};
+    return increasing_range(mpfr_tan, lo, hi);
+}
+
 // ---- the check ----
 struct Kernel {
     const char* name;
@@ -260,7 +289,7 @@ struct Kernel {
 };
 
 struct Tally {
-    std::uint64_t pairs = 0, checked = 0, violations = 0, empty_ok = 0, exact = 0, negative_sqrt = 0;
+    std::uint64_t pairs = 0, checked = 0, violations = 0, empty_ok = 0, exact = 0, outside_domain = 0;
     // width / exact width in the kernel's domain (|lo|, |hi| <= 2^30; exp: 700): all, and exact width >=
     // 2^-20
     std::vector<double> ratios, cell_ratios;
@@ -298,11 +327,12 @@ Tally check(const Kernel& k, const std::vector<Interval>& in, const std::vector<
         }
         const ExactRange& x = exact[i];
         if (!x.defined) {
-            // sqrt of a negative interval is empty; sin and cos of {inf} have nothing to contain.
-            if (k.op == ir::Op::Sqrt) {
+            // sqrt and log of a negative interval are empty; sin, cos and tan of {inf} have nothing to
+            // contain.
+            if (k.op == ir::Op::Sqrt || k.op == ir::Op::Log) {
                 ++t.checked;
-                ++t.negative_sqrt;
-                if (!r.is_empty()) fail("sqrt of a negative interval is not empty");
+                ++t.outside_domain;
+                if (!r.is_empty()) fail("an interval outside the domain does not give an empty result");
             }
             continue;
         }
@@ -314,8 +344,9 @@ Tally check(const Kernel& k, const std::vector<Interval>& in, const std::vector<
         if (r.lo == x.lo && r.hi == x.hi) ++t.exact;
         const double w = x.hi - x.lo;
         // Tightness within the kernels' own domain (beyond it the numeric core answers).
-        const double domain = k.op == ir::Op::Exp ? 700 : 0x1p30;
-        if (w > 0 && std::isfinite(w) && std::fabs(a.lo) <= domain && std::fabs(a.hi) <= domain) {
+        const double domain = k.op == ir::Op::Exp ? 700 : k.op == ir::Op::Log ? 0x1p1023 : 0x1p30;
+        const bool in_domain = k.op == ir::Op::Log ? a.lo >= 0x1p-1022 : std::fabs(a.lo) <= domain;
+        if (w > 0 && std::isfinite(w) && in_domain && std::fabs(a.hi) <= domain) {
             const double ratio = (r.hi - r.lo) / w;
             t.ratios.push_back(ratio);
             if (w >= 0x1p-20 * std::max({1.0, std::fabs(x.lo), std::fabs(x.hi)}))
@@ -349,8 +380,8 @@ int main(int argc, char** argv) {
                                                                     {"constrained x4", {R::constrained, 4}},
                                                                     {"constrained x1", {R::constrained, 1}}};
     if (jit::host_has_avx512()) variants.push_back({"avx512 x1", {R::avx512, 1}});
-    const Kernel kernels[] = {
-        {"sqrt", ir::Op::Sqrt}, {"sin", ir::Op::Sin}, {"cos", ir::Op::Cos}, {"exp", ir::Op::Exp}};
+    const Kernel kernels[] = {{"sqrt", ir::Op::Sqrt}, {"sin", ir::Op::Sin}, {"cos", ir::Op::Cos},
+                              {"exp", ir::Op::Exp},   {"tan", ir::Op::Tan}, {"log", ir::Op::Log}};
 
     int passed = 0, failed = 0;
     std::uint64_t total_checked = 0;
@@ -364,6 +395,8 @@ int main(int argc, char** argv) {
             if (in[i].is_empty()) continue;
             exact[i] = k.op == ir::Op::Sqrt  ? sqrt_range(in[i].lo, in[i].hi)
                        : k.op == ir::Op::Exp ? increasing_range(mpfr_exp, in[i].lo, in[i].hi)
+                       : k.op == ir::Op::Tan ? tan_range(in[i].lo, in[i].hi)
+                       : k.op == ir::Op::Log ? log_range(in[i].lo, in[i].hi)
                                              : sincos_range(in[i].lo, in[i].hi, k.op == ir::Op::Cos);
         }
         ir::Graph g;
@@ -382,7 +415,7 @@ int main(int argc, char** argv) {
                         ratio_summary(t.cell_ratios).c_str());
             const bool ok = t.violations == 0 && t.checked > pairs / 2;
             // sqrt is exact: directed rounding gives the correctly rounded range on every pair with a value.
-            const bool tight = k.op != ir::Op::Sqrt || t.exact + t.negative_sqrt == t.checked;
+            const bool tight = k.op != ir::Op::Sqrt || t.exact + t.outside_domain == t.checked;
             if (ok && tight) {
                 ++passed;
             } else {

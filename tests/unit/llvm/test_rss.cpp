@@ -51,8 +51,8 @@ TEST_CASE("identical RSS covers for every stdlib shape", "[llvm][rss]") {
             CHECK(ri.boundary == rj.boundary);
             CHECK(ri.evaluated == rj.evaluated);
             CHECK(in->stats.calls == jt->stats.calls);
-            // Term counts: the inline sin/cos/exp kernels enclose a few ulps more loosely and adaptive
-            // truncation looks at widths, so they are compared with the core's calls.
+            // Term counts: the inline sin/cos/exp/tan/log kernels enclose a few ulps more loosely and
+            // adaptive truncation looks at widths, so they are compared with the core's calls.
             auto jx = make_jit_exact_calls(m.tapes[i]);
             rt::subdivide(*jx, s.box, o);
             CHECK(in->stats.series_terms == jx->stats.series_terms);
