@@ -86,7 +86,7 @@ public:
         }
     }
 
-    // FRAC_JIT_EXACT_CALLS=1 in the environment: sqrt, sin, cos, exp, tan and log call the numeric core
+    // FRAC_JIT_EXACT_CALLS=1 in the environment: sqrt, sin, cos, exp, tan, log and pow call the numeric core
     // (correctly rounded, bit for bit the interpreter's) instead of the inline kernels; for benchmarks and
     // tests.
     static bool exact_calls_requested() {
@@ -352,6 +352,14 @@ private:
     SlotState op_log(const SlotState& a);
     // An approximation of log(x) for a positive normal x, error below 2^-47 |log x| (0 at x = 1).
     Value* log_value(Value* x);
+    // Enclosures of log over [lo, hi] (positive normal ends) and exp over [lo, hi] (|ends| <= 700), from
+    // the endpoint values and their bounds; no checks of the lanes.
+    IV log_bounds(const IV& x);
+    Value* positive_normal(const IV& x);
+    IV exp_bounds(const IV& x);
+    // pow(x, y) = exp(y log x) for a positive base and an exponent that is not a thin integer (those take
+    // powi's exact path in the core).
+    SlotState op_pow(const SlotState& a, const SlotState& b);
     SlotState op_powi(const SlotState& a, std::int64_t n);
     SlotState op_minmax(const SlotState& a, const SlotState& b, bool is_min);
     SlotState op_round(const SlotState& a, bool up);
@@ -399,8 +407,8 @@ private:
     SlotState emit_series(const Instr& ins);
 
     bool avx512_;
-    bool fast_kernels_; // inline sqrt, sin, cos, exp, tan, log (FRAC_JIT_EXACT_CALLS=1: the numeric core's
-                        // calls)
+    bool fast_kernels_; // inline sqrt, sin, cos, exp, tan, log, pow (FRAC_JIT_EXACT_CALLS=1: the numeric
+                        // core's calls)
     Type *vt_, *mt_, *vi64_;
     Value* scratch_in_ = nullptr;
     Value* scratch_n_ = nullptr;

@@ -94,9 +94,7 @@ Value* BoxGen::exp_value(Value* x) {
     return mul(p, b_.CreateBitCast(bits, vt_));
 }
 
-SlotState BoxGen::op_exp(const SlotState& a) {
-    const IV& x = a.v;
-    Value* fast = land(le(x.lo, x.hi), land(ge(x.lo, cst(-exp_fast_limit)), le(x.hi, cst(exp_fast_limit))));
+IV BoxGen::exp_bounds(const IV& x) {
     // exp is increasing: the lower bound at lo, the upper one at hi.
     Value* at_lo = exp_value(x.lo);
     Value* at_hi = exp_value(x.hi);
@@ -104,8 +102,13 @@ SlotState BoxGen::op_exp(const SlotState& a) {
     auto err = [&](Value* at, Value* arg) {
         return sel(eq(arg, cst(0.0)), cst(0.0), mul(at, cst(exp_rel_bound)));
     };
-    const IV r{std_max(sub_down(at_lo, err(at_lo, x.lo)), cst(0.0)), add(at_hi, err(at_hi, x.hi))};
-    return result(with_fallback(fast, r, Op::Exp, {&a}), a.f.maybe_empty);
+    return {std_max(sub_down(at_lo, err(at_lo, x.lo)), cst(0.0)), add(at_hi, err(at_hi, x.hi))};
+}
+
+SlotState BoxGen::op_exp(const SlotState& a) {
+    const IV& x = a.v;
+    Value* fast = land(le(x.lo, x.hi), land(ge(x.lo, cst(-exp_fast_limit)), le(x.hi, cst(exp_fast_limit))));
+    return result(with_fallback(fast, exp_bounds(x), Op::Exp, {&a}), a.f.maybe_empty);
 }
 
 IV BoxGen::sincos_point(Value* x, int shift) {
@@ -216,19 +219,43 @@ Value* BoxGen::log_value(Value* x) {
     return fma(e, cst(ln2_hi), fma(e, cst(ln2_lo), log_m)); // e H is exact
 }
 
-SlotState BoxGen::op_log(const SlotState& a) {
-    const IV& x = a.v;
-    // numeric/interval.cpp: empty when a is empty or a.hi <= 0, a lower bound <= 0 gives -inf. The fast
-    // lanes: both ends positive normal doubles.
-    Value* fast = land(le(x.lo, x.hi), land(ge(x.lo, cst(log_fast_min)), lt(x.hi, cst(inf))));
+IV BoxGen::log_bounds(const IV& x) {
     Value* at_lo = log_value(x.lo);
     Value* at_hi = log_value(x.hi);
     // log 1 = 0 is exact (s = 0, e = 0) and kept thin.
     auto err = [&](Value* at, Value* arg) {
         return sel(eq(arg, cst(1.0)), cst(0.0), add(mul(fabs(at), cst(log_rel_bound)), cst(abs_floor)));
     };
-    const IV r{sub_down(at_lo, err(at_lo, x.lo)), add(at_hi, err(at_hi, x.hi))};
-    return result(with_fallback(fast, r, Op::Log, {&a}), true); // log of x <= 0 is empty
+    return {sub_down(at_lo, err(at_lo, x.lo)), add(at_hi, err(at_hi, x.hi))};
+}
+
+// Lanes whose ends are positive normal doubles.
+Value* BoxGen::positive_normal(const IV& x) {
+    return land(le(x.lo, x.hi), land(ge(x.lo, cst(log_fast_min)), lt(x.hi, cst(inf))));
+}
+
+SlotState BoxGen::op_log(const SlotState& a) {
+    // numeric/interval.cpp: empty when a is empty or a.hi <= 0, a lower bound <= 0 gives -inf; those
+    // lanes call the core.
+    return result(with_fallback(positive_normal(a.v), log_bounds(a.v), Op::Log, {&a}), true);
+}
+
+SlotState BoxGen::op_pow(const SlotState& a, const SlotState& b) {
+    // numeric/interval.cpp: a thin integer exponent takes powi; otherwise exp(b log(a n [0, inf])). Fast
+    // lanes: a positive normal base, a finite exponent that is not a thin integer, |b log a| <= 700.
+    const IV& x = a.v;
+    const IV& y = b.v;
+    Value* integer = land(eq(y.lo, y.hi), eq(floor(y.lo), y.lo));
+    Value* finite = land(le(y.lo, y.hi), land(gt(y.lo, cst(-inf)), lt(y.hi, cst(inf))));
+    const IV l = log_bounds(x);
+    // y l, outward: the extremes among the four products (all finite here).
+    Value* p_lo = std_min(std_min(mul_down(y.lo, l.lo), mul_down(y.lo, l.hi)),
+                          std_min(mul_down(y.hi, l.lo), mul_down(y.hi, l.hi)));
+    Value* p_hi =
+        std_max(std_max(mul(y.lo, l.lo), mul(y.lo, l.hi)), std_max(mul(y.hi, l.lo), mul(y.hi, l.hi)));
+    Value* fast = land(land(positive_normal(x), land(finite, lnot(integer))),
+                       land(ge(p_lo, cst(-exp_fast_limit)), le(p_hi, cst(exp_fast_limit))));
+    return result(with_fallback(fast, exp_bounds({p_lo, p_hi}), Op::Pow, {&a, &b}), true);
 }
 
 } // namespace frac::jit::box

@@ -245,8 +245,10 @@ SlotState BoxGen::emit_op(const Instr& ins) {
         return call_core(ins.op, 0, {&in(0)}, in(0).f.maybe_empty);
     case Op::Log:
         if (fast_kernels_ && ir::arity(ins.op) == 1) return op_log(in(0));
-        [[fallthrough]];
-    case Op::Pow: return call_core(ins.op, 0, {&in(0), &in(ir::arity(ins.op) > 1 ? 1 : 0)}, true);
+        return call_core(ins.op, 0, {&in(0), &in(ir::arity(ins.op) > 1 ? 1 : 0)}, true);
+    case Op::Pow:
+        if (fast_kernels_) return op_pow(in(0), in(1));
+        return call_core(ins.op, 0, {&in(0), &in(1)}, true);
     case Op::Exp:
         if (fast_kernels_) return op_exp(in(0));
         return call_core(ins.op, 0, {&in(0)}, in(0).f.maybe_empty);

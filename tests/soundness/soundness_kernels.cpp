@@ -1,4 +1,4 @@
-// Soundness and tightness of the JIT's inline interval kernels (sqrt, sin, cos, exp, tan, log;
+// Soundness and tightness of the JIT's inline interval kernels (sqrt, sin, cos, exp, tan, log, pow;
 // backend/llvm/box_kernels.cpp) against the exact range computed with MPFR: for random intervals of many
 // widths and magnitudes, and the hard cases (near multiples of pi/2, huge arguments, tiny and thin intervals,
 // zeros, infinities, NaN and empty intervals), the JIT's enclosure [L, H] of f over [lo, hi] must satisfy L
@@ -68,6 +68,24 @@ public:
             default: return around(std::ldexp(1.0 + unit(), pick(2) ? -1022 - pick(4) : 1020 + pick(4)));
             }
         default: return uniform(-10, 10);
+        }
+    }
+
+    // A positive interval of any magnitude, subnormal to huge, of any width.
+    Interval positive() {
+        const double c = std::ldexp(1.0 + unit(), pick(2098) - 1074);
+        Interval a = around(c);
+        if (!(a.lo > 0)) a.lo = c;
+        return a;
+    }
+    // An exponent: ordinary, thin integers (powi's path), around 0, large.
+    Interval exponent() {
+        switch (pick(5)) {
+        case 0: return thin(static_cast<double>(pick(41) - 20));
+        case 1: return around(signed_magnitude(-30, 3));
+        case 2: return around(signed_magnitude(3, 12));
+        case 3: return pick(8) == 0 ? not_an_interval() : uniform(-4, 4);
+        default: return around(signed_magnitude(-3, 3));
         }
     }
 
@@ -282,6 +300,23 @@ ExactRange tan_range(double lo, double hi) {
     return increasing_range(mpfr_tan, lo, hi);
 }
 
+// x^y over a box with x > 0: monotone in x for each y and in y for each x, so the extremes are at the
+// corners (MPFR's pow, correctly rounded down and up).
+ExactRange pow_range(Interval x, Interval y) {
+    ExactRange e{true, inf, -inf};
+    Mpfr xv, yv, r;
+    for (const double a : {x.lo, x.hi})
+        for (const double b : {y.lo, y.hi}) {
+            mpfr_set_d(xv.v, a, MPFR_RNDN);
+            mpfr_set_d(yv.v, b, MPFR_RNDN);
+            mpfr_pow(r.v, xv.v, yv.v, MPFR_RNDD);
+            e.lo = std::min(e.lo, mpfr_get_d(r.v, MPFR_RNDD));
+            mpfr_pow(r.v, xv.v, yv.v, MPFR_RNDU);
+            e.hi = std::max(e.hi, mpfr_get_d(r.v, MPFR_RNDU));
+        }
+    return e;
+}
+
 // ---- the check ----
 struct Kernel {
     const char* name;
@@ -440,6 +475,79 @@ int main(int argc, char** argv) {
                 ++failed;
                 std::printf("FAIL: %s: the check did not catch narrowed enclosures\n", k.name);
             }
+        }
+    }
+    // pow(x, y): positive bases, exponents of every kind; the result over each box must contain the
+    // exact range, and an empty exponent give an empty result.
+    {
+        IntervalMaker maker(seed++);
+        std::vector<Interval> boxes(2 * pairs);
+        std::vector<ExactRange> exact(pairs);
+        for (std::uint64_t i = 0; i < pairs; ++i) {
+            boxes[2 * i] = maker.positive();
+            boxes[2 * i + 1] = maker.exponent();
+            if (!boxes[2 * i + 1].is_empty()) exact[i] = pow_range(boxes[2 * i], boxes[2 * i + 1]);
+        }
+        ir::Graph g;
+        const ir::Tape tape = ir::build_tape(g, g.op(ir::Op::Pow, g.var(0), g.var(1)), 2);
+        struct PowTally {
+            std::uint64_t checked = 0, violations = 0;
+            std::vector<double> ratios;
+            std::string first;
+        };
+        auto tally = [&](const std::vector<Interval>& out) {
+            PowTally t;
+            for (std::uint64_t i = 0; i < pairs; ++i) {
+                const Interval x = boxes[2 * i], y = boxes[2 * i + 1], r = out[i];
+                std::string why;
+                if (y.is_empty()) {
+                    if (!r.is_empty()) why = "an empty exponent gives a non-empty result";
+                } else if (!(r.lo <= exact[i].lo && exact[i].hi <= r.hi)) {
+                    why = "the exact range is [" + hex(exact[i].lo) + ", " + hex(exact[i].hi) + "]";
+                } else {
+                    const double w = exact[i].hi - exact[i].lo;
+                    if (w >= 0x1p-20 * std::max({1.0, std::fabs(exact[i].lo), std::fabs(exact[i].hi)}) &&
+                        std::isfinite(w))
+                        t.ratios.push_back((r.hi - r.lo) / w);
+                }
+                ++t.checked;
+                if (why.empty()) continue;
+                ++t.violations;
+                if (t.first.empty())
+                    t.first = "pow([" + hex(x.lo) + ", " + hex(x.hi) + "], [" + hex(y.lo) + ", " + hex(y.hi) +
+                              "]) = [" + hex(r.lo) + ", " + hex(r.hi) + "]: " + why;
+            }
+            return t;
+        };
+        for (const auto& [label, config] : variants) {
+            auto e = jit::make_jit(tape, {}, config);
+            std::vector<Interval> out(pairs);
+            e->eval_boxes(boxes.data(), pairs, out.data());
+            const PowTally t = tally(out);
+            total_checked += t.checked;
+            std::printf("pow  %-15s %llu boxes checked, %llu violations; width / exact width (exact width >= "
+                        "2^-20 max(1, |f|)): %s\n",
+                        label.c_str(), static_cast<unsigned long long>(t.checked),
+                        static_cast<unsigned long long>(t.violations), ratio_summary(t.ratios).c_str());
+            if (t.violations == 0 && t.checked == pairs) {
+                ++passed;
+            } else {
+                ++failed;
+                std::printf("FAIL: pow %s: %s\n", label.c_str(), t.first.c_str());
+            }
+        }
+        // The check must be able to fail: the interpreter's enclosures narrowed by one double at each end.
+        auto interp = interp::make_interpreter(tape);
+        std::vector<Interval> narrowed(pairs);
+        interp->eval_boxes(boxes.data(), pairs, narrowed.data());
+        for (Interval& r : narrowed)
+            if (!r.is_empty() && std::isfinite(r.lo) && std::isfinite(r.hi) && r.lo < r.hi)
+                r = {std::nextafter(r.lo, inf), std::nextafter(r.hi, -inf)};
+        if (tally(narrowed).violations > 0) {
+            ++passed;
+        } else {
+            ++failed;
+            std::printf("FAIL: pow: the check did not catch narrowed enclosures\n");
         }
     }
     std::printf("%llu (interval, kernel, variant) checks\n%d passed, %d failed\n",
