@@ -362,6 +362,7 @@ int run(int argc, char** argv) {
         cli::set_constant_overrides(sets);
         cli::set_free_entry_seed(free_entry_seed);
         engine.max_compile_instructions = cli::compile_instruction_limit();
+        engine.jit_cache_dir = cli::jit_cache_dir();
         if (*check) return cli::run_check(file, emit, shape, time_passes);
         if (*eval) return cli::run_eval(file, shape, at, box, engine);
         if (*render) return cli::run_render(file, render_options, engine);

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <iostream>
 #include <sstream>
+#include <string_view>
 
 namespace frac::cli {
 
@@ -55,6 +56,15 @@ std::size_t compile_instruction_limit() {
     std::size_t limit = driver::EngineOptions{}.max_compile_instructions;
     limit_from_env("FRAC_MAX_COMPILE_INSTRUCTIONS", "instructions", 1e9, limit);
     return limit;
+}
+
+std::string jit_cache_dir() {
+    if (const char* dir = std::getenv("FRAC_CACHE_DIR")) return std::string_view(dir) == "off" ? "" : dir;
+    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg == '/')
+        return std::string(xdg) + "/frac";
+    if (const char* home = std::getenv("HOME"); home && *home == '/')
+        return std::string(home) + "/.cache/frac";
+    return "";
 }
 
 front::Limits frontend_limits() {

@@ -35,6 +35,9 @@ void set_free_entry_seed(std::optional<std::uint64_t> seed);
 front::Limits frontend_limits();
 // The most instructions of compiled code: 20,000, or FRAC_MAX_COMPILE_INSTRUCTIONS (at most 10^9).
 std::size_t compile_instruction_limit();
+// The JIT's on-disk cache of machine code (backend/llvm/code_cache.hpp): $FRAC_CACHE_DIR ("off" or
+// empty: none), else $XDG_CACHE_HOME/frac, else $HOME/.cache/frac, else none.
+std::string jit_cache_dir();
 
 // Compiles `path`; on errors prints the diagnostics to stderr and returns null.
 // `times`, when not null, gets the time of each stage run.

@@ -59,7 +59,9 @@ std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId
         std::string why;
         if (jit::jit_available(&why)) {
             try {
-                return jit::make_jit(tape, options.eval);
+                jit::JitConfig config;
+                config.cache_dir = options.jit_cache_dir;
+                return jit::make_jit(tape, options.eval, config);
             } catch (const jit::JitError& e) {
                 why = e.what();
             }

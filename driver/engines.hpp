@@ -16,6 +16,7 @@ struct EngineOptions {
     ir::EvalOptions eval;
     int threads = 0;                              // subdivision threads; 0: all cores
     std::size_t max_compile_instructions = 20000; // aot: FRAC_MAX_COMPILE_INSTRUCTIONS (cli/session.hpp)
+    std::string jit_cache_dir; // the JIT's on-disk cache of machine code; empty: none (cli/session.hpp)
 };
 
 // A user-facing run-time failure (I/O, a computation that cannot be done): message and exit code 1.

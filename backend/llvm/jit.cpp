@@ -1,6 +1,7 @@
 #include "backend/llvm/jit.hpp"
 
 #include "backend/interp/interpreter.hpp"
+#include "backend/llvm/code_cache.hpp"
 #include "backend/llvm/codegen.hpp"
 #include "backend/llvm/helpers.hpp"
 #include "backend/llvm/pipeline.hpp"
@@ -14,14 +15,17 @@
 #include <llvm/ExecutionEngine/Orc/ThreadSafeModule.h>
 #include <llvm/IR/LLVMContext.h>
 #include <llvm/IR/Module.h>
+#include <llvm/Support/MemoryBuffer.h>
 #include <llvm/Support/TargetSelect.h>
 #include <llvm/Support/raw_ostream.h>
 #include <llvm/Target/TargetMachine.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstddef>
 #include <mutex>
+#include <optional>
 
 namespace frac::jit {
 namespace {
@@ -63,6 +67,7 @@ public:
     std::atomic<std::uint64_t> counter{0};
     bool avx512 = false; // the host has AVX-512F
     bool avx = false;    // ... AVX
+    std::string target;  // what decides an object besides its IR (the cache key's part)
 
     int lanes_for(const JitConfig& c, Rounding r) const {
         int lanes = c.lanes;
@@ -102,19 +107,9 @@ private:
             error = "cannot create an LLVM target machine: " + to_string(tm.takeError());
             return nullptr;
         }
-        // One target machine for every compile (compiles are serialised by `mu`): LLJIT's default
-        // creates a new one per module, a few milliseconds each time.
-        auto jit =
-            llvm::orc::LLJITBuilder()
-                .setJITTargetMachineBuilder(*jtmb)
-                .setCompileFunctionCreator(
-                    [](llvm::orc::JITTargetMachineBuilder b)
-                        -> llvm::Expected<std::unique_ptr<llvm::orc::IRCompileLayer::IRCompiler>> {
-                        auto machine = b.createTargetMachine();
-                        if (!machine) return machine.takeError();
-                        return std::make_unique<llvm::orc::TMOwningSimpleCompiler>(std::move(*machine));
-                    })
-                .create();
+        // Modules are compiled to objects by `tm` (compile() below, serialised by `mu`: one target
+        // machine for every compile) and linked from there, so that an object can come from the cache.
+        auto jit = llvm::orc::LLJITBuilder().setJITTargetMachineBuilder(*jtmb).create();
         if (!jit) {
             error = "cannot start the LLVM ORC JIT: " + to_string(jit.takeError());
             return nullptr;
@@ -135,6 +130,8 @@ private:
         }
         e->jit = std::move(*jit);
         e->tm = std::move(*tm);
+        e->target = e->tm->getTargetTriple().str() + " " + e->tm->getTargetCPU().str() + " " +
+                    e->tm->getTargetFeatureString().str() + " codegen-level-default";
         return e;
     }
 };
@@ -182,16 +179,23 @@ struct Compiled {
     bool has_choices = false; // block 0 has min/max/select instructions to prune
     BatchBoxes boxes = nullptr;
     BatchPoints points = nullptr;
-    llvm::orc::ResourceTrackerSP tracker;
+    // Each tape's code is linked into its own library, so that every module can use the same symbol
+    // names: its object is then the same in every process, and can be cached.
+    llvm::orc::JITDylib* dylib = nullptr;
     CompileInfo info;
 
     ~Compiled() {
-        if (!tracker) return;
+        if (!dylib) return;
         Engine* e = Engine::get(nullptr);
         std::lock_guard<std::mutex> lock(e->mu);
-        llvm::consumeError(tracker->remove());
+        llvm::consumeError(e->jit->getExecutionSession().removeJITDylib(*dylib));
     }
 };
+
+bool calls_externals(const ir::Tape& tape) {
+    return std::any_of(tape.externals.begin(), tape.externals.end(),
+                       [](const auto& f) { return f != nullptr; });
+}
 
 class JitEvaluator final : public ir::Evaluator {
 public:
@@ -326,29 +330,56 @@ std::shared_ptr<const Compiled> compile(const ir::Tape& tape, const ir::EvalOpti
     info.tables_ms = ms_since(t);
     info.table_bytes = table_bytes(tables);
 
-    const std::string name = "frac" + std::to_string(engine->counter++);
     std::lock_guard<std::mutex> lock(engine->mu);
     t = Clock::now();
-    Generated g = generate_module(tape, options, tables, name, engine, rounding, lanes);
+    Generated g = generate_module(tape, options, tables, "frac", engine, rounding, lanes);
     info.codegen_ms = ms_since(t);
-    t = Clock::now();
-    optimize(*g.module, engine->tm.get());
-    info.optimize_ms = ms_since(t);
-    info.ir_instructions = instruction_count(*g.module);
+
+    std::unique_ptr<llvm::MemoryBuffer> object;
+    std::optional<CodeCache> cache;
+    std::string key;
+    if (!config.cache_dir.empty() && !calls_externals(tape)) {
+        t = Clock::now();
+        cache.emplace(config.cache_dir, config.cache_max_bytes);
+        std::string ir;
+        llvm::raw_string_ostream os(ir);
+        g.module->print(os, nullptr);
+        key = CodeCache::key(os.str(), engine->target);
+        object = cache->load(key);
+        info.cache = object ? "hit" : "miss";
+        info.cache_ms = ms_since(t);
+    }
+    if (!object) {
+        t = Clock::now();
+        optimize(*g.module, engine->tm.get());
+        info.optimize_ms = ms_since(t);
+        info.ir_instructions = instruction_count(*g.module);
+        t = Clock::now();
+        auto compiled = llvm::orc::SimpleCompiler(*engine->tm)(*g.module);
+        if (!compiled) throw JitError("LLVM could not compile a shape: " + to_string(compiled.takeError()));
+        object = std::move(*compiled);
+        info.machine_ms = ms_since(t);
+        if (cache) {
+            t = Clock::now();
+            cache->store(key, std::string_view(object->getBufferStart(), object->getBufferSize()));
+            info.cache_ms += ms_since(t);
+        }
+    }
 
     t = Clock::now();
-    llvm::orc::JITDylib& jd = engine->jit->getMainJITDylib();
-    code->tracker = jd.createResourceTracker();
-    if (auto err = engine->jit->addIRModule(
-            code->tracker, llvm::orc::ThreadSafeModule(std::move(g.module), std::move(g.ctx))))
-        throw JitError("the LLVM JIT rejected a module: " + to_string(std::move(err)));
-    auto box = engine->jit->lookup(g.names.box);
-    if (!box) throw JitError("the LLVM JIT could not compile a shape: " + to_string(box.takeError()));
-    auto point = engine->jit->lookup(g.names.point);
+    auto dylib = engine->jit->createJITDylib("frac" + std::to_string(engine->counter++));
+    if (!dylib) throw JitError("the LLVM JIT cannot make a library: " + to_string(dylib.takeError()));
+    code->dylib = &*dylib;
+    dylib->addToLinkOrder(engine->jit->getMainJITDylib()); // the helpers
+    if (auto err = engine->jit->addObjectFile(*dylib, std::move(object)))
+        throw JitError("the LLVM JIT rejected an object: " + to_string(std::move(err)));
+    auto box = engine->jit->lookup(*dylib, g.names.box);
+    if (!box) throw JitError("the LLVM JIT could not link a shape: " + to_string(box.takeError()));
+    auto point = engine->jit->lookup(*dylib, g.names.point);
     if (!point) throw JitError("the LLVM JIT could not compile a shape: " + to_string(point.takeError()));
     code->boxes = box->toPtr<BatchBoxes>();
     code->points = point->toPtr<BatchPoints>();
-    info.machine_ms = ms_since(t);
+    info.machine_ms += ms_since(t);
     info.total_ms = ms_since(t0);
     return code;
 }

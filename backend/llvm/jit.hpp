@@ -41,7 +41,20 @@ struct JitConfig {
     // Boxes evaluated at once by the interval code, one per vector lane: 0 chooses for the host (8 with
     // AVX-512, 4 with AVX, else 2); 1 is scalar code. AVX-512 rounding needs 1 or 8.
     int lanes = 0;
+    // The on-disk cache of machine code (code_cache.hpp): a directory, or empty for none (the library's
+    // default; the CLI uses $FRAC_CACHE_DIR, else $XDG_CACHE_HOME/frac, else ~/.cache/frac). Tapes
+    // that call external functions embed their addresses and are never cached.
+    std::string cache_dir;
+    std::size_t cache_max_bytes = std::size_t{256} << 20;
 };
+
+// A configuration that chooses the form of the code only (no cache).
+inline JitConfig codegen_config(JitConfig::Rounding rounding, int lanes) {
+    JitConfig c;
+    c.rounding = rounding;
+    c.lanes = lanes;
+    return c;
+}
 
 // Whether the host can run the AVX-512 form of the generated code.
 bool host_has_avx512();
@@ -70,10 +83,14 @@ struct CompileInfo {
     double optimize_ms = 0;          // LLVM IR passes
     double machine_ms = 0;           // instruction selection, emission and linking in the JIT
     double total_ms = 0;             // make_jit from start to finish
-    std::size_t ir_instructions = 0; // after optimisation
+    std::size_t ir_instructions = 0; // after optimisation (0 when the object came from the cache)
     std::size_t table_bytes = 0;
     std::string rounding; // "avx512" or "constrained"
     int lanes = 1;        // boxes per vector of the interval code
+    // The on-disk cache: "off" (none, or the tape calls external functions), "miss" (compiled, then
+    // stored) or "hit" (loaded: no optimisation, no code generation).
+    std::string cache = "off";
+    double cache_ms = 0; // printing and hashing the IR, reading or writing the entry
 };
 // The compile info of a JIT evaluator (or a clone); nullptr for any other engine.
 const CompileInfo* compile_info(const ir::Evaluator& e);

@@ -411,10 +411,11 @@ int main(int argc, char** argv) {
     if (const char* v = std::getenv("FRAC_JIT_EXACT_CALLS"); v && std::string(v) == "1")
         std::printf("note: FRAC_JIT_EXACT_CALLS=1, the kernels are the numeric core's calls\n");
     using R = jit::JitConfig::Rounding;
-    std::vector<std::pair<std::string, jit::JitConfig>> variants = {{"default", {R::automatic, 0}},
-                                                                    {"constrained x4", {R::constrained, 4}},
-                                                                    {"constrained x1", {R::constrained, 1}}};
-    if (jit::host_has_avx512()) variants.push_back({"avx512 x1", {R::avx512, 1}});
+    std::vector<std::pair<std::string, jit::JitConfig>> variants = {
+        {"default", jit::codegen_config(R::automatic, 0)},
+        {"constrained x4", jit::codegen_config(R::constrained, 4)},
+        {"constrained x1", jit::codegen_config(R::constrained, 1)}};
+    if (jit::host_has_avx512()) variants.push_back({"avx512 x1", jit::codegen_config(R::avx512, 1)});
     const Kernel kernels[] = {{"sqrt", ir::Op::Sqrt}, {"sin", ir::Op::Sin}, {"cos", ir::Op::Cos},
                               {"exp", ir::Op::Exp},   {"tan", ir::Op::Tan}, {"log", ir::Op::Log}};
 

@@ -14,10 +14,12 @@ struct CrossCheckResult {
 // The code generator's variants: the host's default and each rounding form at several widths.
 inline std::vector<jit::JitConfig> jit_configs() {
     using R = jit::JitConfig::Rounding;
-    std::vector<jit::JitConfig> c = {{R::automatic, 0}, {R::constrained, 1}, {R::constrained, 4}};
+    std::vector<jit::JitConfig> c = {jit::codegen_config(R::automatic, 0),
+                                     jit::codegen_config(R::constrained, 1),
+                                     jit::codegen_config(R::constrained, 4)};
     if (jit::host_has_avx512()) {
-        c.push_back({R::avx512, 1});
-        c.push_back({R::constrained, 8});
+        c.push_back(jit::codegen_config(R::avx512, 1));
+        c.push_back(jit::codegen_config(R::constrained, 8));
     }
     return c;
 }

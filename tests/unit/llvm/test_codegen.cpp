@@ -47,8 +47,10 @@ TEST_CASE("interval code rounds upward in every operation, never fast-math", "[l
     using R = jit::JitConfig::Rounding;
     const Model m =
         compile("import \"fractals\"; shape g(x, y) = x / y + sqrt(x) * sin(y) - x^3 + mod(x, 1);");
-    std::vector<jit::JitConfig> configs = {{R::constrained, 1}, {R::constrained, 4}};
-    if (jit::host_has_avx512()) configs.insert(configs.end(), {{R::avx512, 1}, {R::avx512, 8}});
+    std::vector<jit::JitConfig> configs = {jit::codegen_config(R::constrained, 1),
+                                           jit::codegen_config(R::constrained, 4)};
+    if (jit::host_has_avx512())
+        configs.insert(configs.end(), {jit::codegen_config(R::avx512, 1), jit::codegen_config(R::avx512, 8)});
     // (Integer-to-double conversions of series indices below 2^53 are exact: allowed as plain IR in the
     // AVX-512 form, where the optimiser may turn sitofp into uitofp.)
     const std::regex plain(R"(= (fadd|fsub|fmul|fdiv|frem|fptrunc|fpext) )");
