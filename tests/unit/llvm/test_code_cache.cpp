@@ -32,7 +32,8 @@ struct TempDir {
 std::vector<fs::path> entries(const fs::path& dir) {
     std::vector<fs::path> files;
     std::error_code ec;
-    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) files.push_back(it->path());
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+        files.push_back(it->path());
     return files;
 }
 
@@ -186,7 +187,8 @@ shape d(x, y) over [-0.25, 1.25] × [-0.25, 1.25] = dist((x, y), sierpinski) - 0
 TEST_CASE("code cache: the least recently used entries go past the size bound", "[llvm][cache]") {
     const TempDir dir("frac-cache-bound");
     std::vector<Model> models;
-    for (int k = 1; k <= 6; ++k) models.push_back(compile("shape s(x, y) = x * x + y * y - " + std::to_string(k) + ";"));
+    for (int k = 1; k <= 6; ++k)
+        models.push_back(compile("shape s(x, y) = x * x + y * y - " + std::to_string(k) + ";"));
     jit::JitConfig config = cached(dir);
     (void)jit::make_jit(models[0].tapes[0], {}, config);
     const auto one = fs::file_size(entries(dir.path).at(0));
