@@ -5,6 +5,8 @@
 #include "runtime/rss.hpp"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -34,9 +36,21 @@ struct Work {
     int status = 0;
 };
 
+// The work is done and its outputs written. A background compile of the "auto" engine may still be
+// running (the interpreter finished first): leave without waiting for it, and without tearing LLVM
+// down under it.
+int finish(int status) {
+    if (!frac::driver::background_compile_pending()) return status;
+    std::cout.flush();
+    std::cerr.flush();
+    std::fflush(nullptr);
+    std::_Exit(status);
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
+    frac::driver::leave_compiles_at_exit(); // finish() below
     Work work{argc, argv};
     pthread_attr_t attr;
     pthread_t thread;
@@ -47,10 +61,10 @@ int main(int argc, char** argv) {
     };
     if (pthread_attr_init(&attr) != 0 || pthread_attr_setstacksize(&attr, work_stack_bytes) != 0 ||
         pthread_create(&thread, &attr, body, &work) != 0)
-        return run(argc, argv); // no large stack to be had: run on the main thread
+        return finish(run(argc, argv)); // no large stack to be had: run on the main thread
     pthread_join(thread, nullptr);
     pthread_attr_destroy(&attr);
-    return work.status;
+    return finish(work.status);
 }
 
 namespace {
@@ -62,6 +76,7 @@ int run(int argc, char** argv) {
     app.set_version_flag("--version", fmt::format("frac {} (LLVM {})", FRAC_VERSION, FRAC_LLVM_VERSION),
                          "print the version of frac and of the LLVM it uses, then exit");
     cli::EngineOptions engine;
+    engine.engine = "auto";
     // Constant overrides, NAME=VALUE, applied to the model before it is compiled.
     std::vector<std::string> sets;
     // The seed of the values of free bcifs entries: --free-seed everywhere, --seed where the command has
@@ -80,8 +95,9 @@ int run(int argc, char** argv) {
     };
     auto add_engine = [&](CLI::App* sub) {
         sub->add_option("--engine", engine.engine,
-                        "evaluation engine: jit, interp or aot (compiled as by frac compile, then loaded)")
-            ->check(CLI::IsMember({"jit", "interp", "aot"}))
+                        "evaluation engine: auto (the interpreter while the JIT compiles, then the JIT), "
+                        "jit (compiled first), interp, or aot (compiled as by frac compile, then loaded)")
+            ->check(CLI::IsMember({"auto", "jit", "interp", "aot"}))
             ->capture_default_str();
         sub->add_option("--max-terms", engine.eval.max_terms,
                         "most terms of an infinite series before its tail bound")

@@ -3,6 +3,7 @@
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/aot.hpp"
 #include "backend/llvm/jit.hpp"
+#include "backend/llvm/tiered.hpp"
 #include "ir/specialize.hpp"
 #include "ir/tape.hpp"
 
@@ -47,7 +48,9 @@ std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId
     const bool prunable_and_large = options.eval.prune && ir::has_choices(tape) &&
                                     tape.instruction_count() > jit_max_prunable_instructions;
     const bool too_long = tape.instruction_count() > jit_max_instructions;
-    if (options.engine == "jit" && too_long && !prunable_and_large) {
+    const bool automatic = options.engine == "auto";
+    const bool wants_jit = options.engine == "jit" || automatic;
+    if (wants_jit && too_long && !prunable_and_large) {
         static bool told = false; // say it once per run
         if (!told)
             std::cerr << fmt::format(
@@ -55,12 +58,15 @@ std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId
                 "time ({}); using the interpreter\n",
                 tape.instruction_count(), jit_max_instructions);
         told = true;
-    } else if (options.engine == "jit" && !prunable_and_large) {
+    } else if (wants_jit && !prunable_and_large) {
         std::string why;
         if (jit::jit_available(&why)) {
             try {
                 jit::JitConfig config;
                 config.cache_dir = options.jit_cache_dir;
+                // The interpreter serves while LLVM compiles, where that cannot change a result.
+                if (automatic && jit::tiers_exactly(tape))
+                    return jit::make_tiered(tape, options.eval, config);
                 return jit::make_jit(tape, options.eval, config);
             } catch (const jit::JitError& e) {
                 why = e.what();
@@ -78,10 +84,19 @@ std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId
         } catch (const jit::JitError& e) {
             throw RunError(fmt::format("the aot engine cannot be used: {}", e.what()));
         }
-    } else if (options.engine != "interp" && options.engine != "jit") {
-        throw RunError(fmt::format("unknown engine '{}' (available: jit, interp, aot)", options.engine));
+    } else if (options.engine != "interp" && !wants_jit) {
+        throw RunError(
+            fmt::format("unknown engine '{}' (available: auto, jit, interp, aot)", options.engine));
     }
     return interp::make_interpreter(std::move(tape), options.eval);
+}
+
+void leave_compiles_at_exit() {
+    jit::leave_compiles_at_exit();
+}
+
+bool background_compile_pending() {
+    return jit::background_compile_pending();
 }
 
 } // namespace frac::driver

@@ -1,5 +1,6 @@
-// The evaluators of a model's expressions: the JIT by default, the interpreter as its fallback, or a
-// model compiled ahead of time and loaded ("aot").
+// The evaluators of a model's expressions: the JIT, the interpreter as its fallback, both tiered
+// ("auto": the interpreter while LLVM compiles; the command line's default), or a model compiled ahead
+// of time and loaded ("aot").
 #pragma once
 
 #include "frontend/module.hpp"
@@ -12,7 +13,9 @@
 namespace frac::driver {
 
 struct EngineOptions {
-    std::string engine = "jit"; // or "interp" (the fallback when the JIT cannot be used), "aot"
+    // "jit" (compiled before the first evaluation), "auto" (backend/llvm/tiered.hpp), "interp" (the
+    // fallback when the JIT cannot be used), "aot".
+    std::string engine = "jit";
     ir::EvalOptions eval;
     int threads = 0;                              // subdivision threads; 0: all cores
     std::size_t max_compile_instructions = 20000; // aot: FRAC_MAX_COMPILE_INSTRUCTIONS (cli/session.hpp)
@@ -32,5 +35,12 @@ void check_compile_size(std::size_t instructions, std::size_t limit, const std::
 // answers of queries). When the JIT cannot be used, says why once on stderr and interprets.
 std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId root, int inputs,
                                               const EngineOptions& options);
+
+// A program that ends with std::_Exit, after flushing its output, while background_compile_pending()
+// calls leave_compiles_at_exit() first: evaluators of the "auto" engine then do not wait for their
+// compile when they go (backend/llvm/tiered.hpp). The CLI does, so that it never waits for LLVM once
+// its work is done.
+void leave_compiles_at_exit();
+bool background_compile_pending();
 
 } // namespace frac::driver

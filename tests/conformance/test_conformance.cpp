@@ -42,7 +42,7 @@ double takagi_reference(double x) {
 } // namespace
 
 TEMPLATE_TEST_CASE("plain expressions on points and boxes", "[conformance]", InterpEngine, JitEngine,
-                   AotEngine) {
+                   TieredEngine, AotEngine) {
     const Model m = compile("shape s(x, y) = x * x + y * y - 1;");
     auto e = TestType::make(m.tapes[0]);
     CHECK(e->engine() == TestType::name);
@@ -61,7 +61,7 @@ TEMPLATE_TEST_CASE("plain expressions on points and boxes", "[conformance]", Int
 }
 
 TEMPLATE_TEST_CASE("rounding is set by the evaluator and restored", "[conformance]", InterpEngine, JitEngine,
-                   AotEngine) {
+                   TieredEngine, AotEngine) {
     const Model m = compile("shape s(x, y) = x / 3 + y * 0.1;");
     auto e = TestType::make(m.tapes[0]);
     REQUIRE(std::fegetround() == FE_TONEAREST);
@@ -77,7 +77,7 @@ TEMPLATE_TEST_CASE("rounding is set by the evaluator and restored", "[conformanc
 }
 
 TEMPLATE_TEST_CASE("Takagi series: point value and proven enclosure", "[conformance][series]", InterpEngine,
-                   JitEngine, AotEngine) {
+                   JitEngine, TieredEngine, AotEngine) {
     const Model m = compile("shape s(x, y) = y - sum(i in 0.., dz(2^i * x) / 2^i);");
     auto e = TestType::make(m.tapes[0]);
     for (double x : {0.1, 0.3, 1.0 / 3.0, 0.77}) {
@@ -90,7 +90,7 @@ TEMPLATE_TEST_CASE("Takagi series: point value and proven enclosure", "[conforma
 }
 
 TEMPLATE_TEST_CASE("wide boxes are not charged for terms they cannot resolve", "[conformance][series]",
-                   InterpEngine, JitEngine, AotEngine) {
+                   InterpEngine, JitEngine, TieredEngine, AotEngine) {
     const Model m = compile("import \"fractals\";");
     auto e = shape_eval<TestType>(m, "carpet");
     auto reference = shape_eval<InterpEngine>(m, "carpet");
@@ -116,7 +116,7 @@ TEMPLATE_TEST_CASE("wide boxes are not charged for terms they cannot resolve", "
 }
 
 TEMPLATE_TEST_CASE("the term limit caps a series and is counted", "[conformance][series]", InterpEngine,
-                   JitEngine, AotEngine) {
+                   JitEngine, TieredEngine, AotEngine) {
     const Model m = compile("shape s(x, y) = y - sum(i in 0.., dz(2^i * x) / 2^i);");
     ir::EvalOptions o;
     o.max_terms = 5;
@@ -137,7 +137,7 @@ TEMPLATE_TEST_CASE("the term limit caps a series and is counted", "[conformance]
 }
 
 TEMPLATE_TEST_CASE("orbit series update the point simultaneously", "[conformance][series]", InterpEngine,
-                   JitEngine, AotEngine) {
+                   JitEngine, TieredEngine, AotEngine) {
     // p0 = (x, y), p1 = swap(p0) = (y, x): the sum of p.y over both is y + x.
     const Model m =
         compile("fn swap(p) = (p.y, p.x); shape s(x, y) = sum(k in 0..1, p in orbit((x, y), swap), p.y);");
@@ -147,7 +147,7 @@ TEMPLATE_TEST_CASE("orbit series update the point simultaneously", "[conformance
 }
 
 TEMPLATE_TEST_CASE("empty coordinates give empty enclosures", "[conformance]", InterpEngine, JitEngine,
-                   AotEngine) {
+                   TieredEngine, AotEngine) {
     const Model m = compile("import \"fractals\"; shape d(x, y) = sqrt(x) + y;");
     auto carpet = shape_eval<TestType>(m, "carpet");
     CHECK(box2(*carpet, Interval::empty(), {0, 1}).is_empty());
@@ -160,7 +160,7 @@ TEMPLATE_TEST_CASE("empty coordinates give empty enclosures", "[conformance]", I
 }
 
 TEMPLATE_TEST_CASE("batches equal single evaluations, clones are independent", "[conformance]", InterpEngine,
-                   JitEngine, AotEngine) {
+                   JitEngine, TieredEngine, AotEngine) {
     const Model m = compile("import \"fractals\";");
     auto e = shape_eval<TestType>(m, "triangle_stripes");
     BoxMaker mk(3);
@@ -195,7 +195,7 @@ TEMPLATE_TEST_CASE("batches equal single evaluations, clones are independent", "
 }
 
 TEMPLATE_TEST_CASE("clones evaluate on several threads", "[conformance]", InterpEngine, JitEngine,
-                   AotEngine) {
+                   TieredEngine, AotEngine) {
     const Model m = compile("import \"fractals\";");
     auto e = shape_eval<TestType>(m, "carpet");
     const std::vector<Interval> root{{0, 1}, {0, 1}};

@@ -13,7 +13,7 @@
 // Run as `lang_runner FRAC FILE ENGINE`, a command that evaluates (eval, render, mesh, dimension, test,
 // run) gets `--engine ENGINE`, unless its args name one; output files under /tmp/frac-lang- then get
 // the engine in their name, so that the runs under each engine can go on at once. CMake registers a file
-// once per engine (interp, jit and aot by default; `// engines: interp jit` limits it), and once for
+// once per engine (interp, jit, aot and auto by default; `// engines: interp jit` limits it), and once for
 // other commands.
 #include <cstdio>
 #include <cstdlib>

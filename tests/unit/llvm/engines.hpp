@@ -5,6 +5,7 @@
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/aot.hpp"
 #include "backend/llvm/jit.hpp"
+#include "backend/llvm/tiered.hpp"
 #include "driver/pipeline.hpp"
 #include "ir/graph.hpp"
 #include "ir/tape.hpp"
@@ -37,6 +38,15 @@ struct JitEngine {
     static constexpr bool counts_series = true;
     static std::unique_ptr<ir::Evaluator> make(const ir::Tape& t, const ir::EvalOptions& o = {}) {
         return jit::make_jit(t, o);
+    }
+};
+// The command line's default engine ("auto"): the interpreter while the JIT compiles in the background,
+// for tapes where both give the same bits; other tapes are compiled first, as the driver does.
+struct TieredEngine {
+    static constexpr const char* name = "auto";
+    static constexpr bool counts_series = true;
+    static std::unique_ptr<ir::Evaluator> make(const ir::Tape& t, const ir::EvalOptions& o = {}) {
+        return jit::tiers_exactly(t) ? jit::make_tiered(t, o, {}) : jit::make_jit(t, o);
     }
 };
 // The JIT with the numeric core's calls in place of the inline sin, cos, exp, tan, log and pow kernels

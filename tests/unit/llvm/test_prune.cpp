@@ -242,7 +242,7 @@ TEMPLATE_TEST_CASE("what pruning must not touch", "[llvm][prune]", InterpEngine,
 }
 
 TEMPLATE_TEST_CASE("RSS covers are the same with and without pruning", "[llvm][prune][rss]", InterpEngine,
-                   JitEngine) {
+                   JitEngine, TieredEngine) {
     // The CSG shapes of the tests, of the bench and of the examples, and every stdlib shape.
     std::vector<std::pair<std::string, std::string>> sources = {
         {"tests", csg_model},

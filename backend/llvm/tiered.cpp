@@ -1,0 +1,308 @@
+#include "backend/llvm/tiered.hpp"
+
+#include "backend/interp/interpreter.hpp"
+
+#include <pthread.h>
+
+#include <atomic>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <iostream>
+#include <mutex>
+#include <stdexcept>
+#include <type_traits>
+
+namespace frac::jit {
+
+// A thin integer exponent makes the JIT's pow call the numeric core (powi), as the interpreter does.
+// Slots that hold a thin integer wherever they are read: constants and series indices that no
+// instruction overwrites (slots are reused along the tape).
+std::vector<bool> integral_slots(const ir::Tape& tape) {
+    std::vector<bool> integral(tape.num_slots, false);
+    for (const ir::TapeConst& c : tape.constants)
+        if (c.value.lo == c.value.hi && std::floor(c.value.lo) == c.value.lo) integral[c.slot] = true;
+    for (const ir::TapeSeries& series : tape.series)
+        if (series.index_slot != ir::no_slot) integral[series.index_slot] = true;
+    for (const auto& block : tape.blocks)
+        for (const ir::Instr& ins : block)
+            if (ins.out != ir::no_slot) integral[ins.out] = false;
+    for (const ir::Slot input : tape.input_slots)
+        if (input != ir::no_slot) integral[input] = false;
+    return integral;
+}
+
+bool tiers_exactly(const ir::Tape& tape) {
+    const std::vector<bool> integral = integral_slots(tape);
+    for (const auto& block : tape.blocks)
+        for (const ir::Instr& ins : block) switch (ins.op) {
+            case ir::Op::Sin:
+            case ir::Op::Cos:
+            case ir::Op::Exp:
+            case ir::Op::Tan:
+            case ir::Op::Log: return false;
+            case ir::Op::Pow:
+                if (!integral[ins.in[1]]) return false;
+                break;
+            default: break;
+            }
+    return true;
+}
+
+using ir::Interval;
+
+namespace {
+
+enum class Phase { queued, compiling, ready, failed };
+
+// One tape's compile, shared by a tiered evaluator, its clones and the compile thread.
+struct TierState {
+    ir::Tape tape;
+    ir::EvalOptions options;
+    JitConfig config;
+    std::atomic<Phase> phase{Phase::queued};
+    std::unique_ptr<ir::Evaluator> jit; // written before phase becomes ready, then only read
+    std::string error;                  // written before phase becomes failed
+    std::mutex done_mu;
+    std::condition_variable done;
+};
+
+// The background compile thread. LLVM's instruction selection recurses along the code, so the thread
+// gets the large stack the CLI's work thread has (address space only).
+//
+// A compile must not outlive the process's orderly exit: static objects that LLVM made during it
+// (function-local ones, made after this object) are destroyed before this object's destructor could
+// join the thread. So when the last evaluator of a tape goes, its queued compile is dropped and one in
+// progress is waited for, unless the process has said it ends with std::_Exit while one is pending
+// (leave_compiles_at_exit: the CLI, which must not wait for LLVM after its work is done).
+class Compiler {
+public:
+    static Compiler& get() {
+        static Compiler c;
+        return c;
+    }
+
+    // False when no compile thread can be started: the caller compiles itself.
+    bool enqueue(const std::shared_ptr<TierState>& s) {
+        std::lock_guard<std::mutex> lock(mu_);
+        start_locked();
+        if (!started_) return false;
+        jobs_.push_back(s);
+        wake_.notify_one();
+        return true;
+    }
+
+    // The evaluators of `s` are gone.
+    void forget(const TierState* s) {
+        std::unique_lock<std::mutex> lock(mu_);
+        std::erase_if(jobs_, [&](const std::shared_ptr<TierState>& j) { return j.get() == s; });
+        if (!leave_at_exit_) finished_.wait(lock, [&] { return current_ != s; });
+    }
+
+    bool pending() {
+        std::lock_guard<std::mutex> lock(mu_);
+        return current_ != nullptr || !jobs_.empty();
+    }
+
+    void leave_at_exit() {
+        std::lock_guard<std::mutex> lock(mu_);
+        leave_at_exit_ = true;
+    }
+
+    // Compiles on the calling thread (the compile thread's job, or the caller's when there is none).
+    static void compile(TierState& s) {
+        s.phase.store(Phase::compiling, std::memory_order_relaxed);
+        Phase result = Phase::ready;
+        try {
+            s.jit = make_jit(s.tape, s.options, s.config);
+        } catch (const std::exception& e) {
+            s.error = e.what();
+            result = Phase::failed;
+        }
+        {
+            std::lock_guard<std::mutex> lock(s.done_mu);
+            s.phase.store(result, std::memory_order_release);
+        }
+        s.done.notify_all();
+    }
+
+    ~Compiler() {
+        {
+            std::lock_guard<std::mutex> lock(mu_);
+            stop_ = true;
+            jobs_.clear();
+        }
+        wake_.notify_all();
+        if (started_) pthread_join(thread_, nullptr);
+    }
+
+private:
+    void start_locked() {
+        if (started_ || failed_to_start_) return;
+        pthread_attr_t attr;
+        constexpr std::size_t stack_bytes = std::size_t{1} << 30;
+        const auto body = [](void* self) -> void* {
+            static_cast<Compiler*>(self)->loop();
+            return nullptr;
+        };
+        started_ = pthread_attr_init(&attr) == 0 && pthread_attr_setstacksize(&attr, stack_bytes) == 0 &&
+                   pthread_create(&thread_, &attr, body, this) == 0;
+        pthread_attr_destroy(&attr);
+        failed_to_start_ = !started_;
+    }
+
+    void loop() {
+        std::shared_ptr<TierState> s;
+        for (;;) {
+            {
+                std::unique_lock<std::mutex> lock(mu_);
+                if (s) {
+                    current_ = nullptr;
+                    finished_.notify_all();
+                }
+                s = nullptr; // released under the lock: forget() may be waiting to free it
+                wake_.wait(lock, [&] { return stop_ || !jobs_.empty(); });
+                if (stop_) return;
+                s = std::move(jobs_.front());
+                jobs_.pop_front();
+                current_ = s.get();
+            }
+            compile(*s);
+        }
+    }
+
+    std::mutex mu_;
+    std::condition_variable wake_, finished_;
+    std::deque<std::shared_ptr<TierState>> jobs_;
+    const TierState* current_ = nullptr; // being compiled
+    bool stop_ = false, started_ = false, failed_to_start_ = false, leave_at_exit_ = false;
+    pthread_t thread_{};
+};
+
+// Shared by a tiered evaluator and its clones; the last one to go tells the compiler.
+struct TierOwner {
+    std::shared_ptr<TierState> state;
+    explicit TierOwner(std::shared_ptr<TierState> s) : state(std::move(s)) {}
+    TierOwner(const TierOwner&) = delete;
+    TierOwner& operator=(const TierOwner&) = delete;
+    ~TierOwner() { Compiler::get().forget(state.get()); }
+};
+
+class TieredEvaluator final : public ir::Evaluator {
+public:
+    TieredEvaluator(std::shared_ptr<TierOwner> owner, std::unique_ptr<ir::Evaluator> interp,
+                    std::unique_ptr<ir::Evaluator> jit)
+        : owner_(std::move(owner)), interp_(std::move(interp)), jit_(std::move(jit)) {}
+
+    int dimension() const override { return interp_->dimension(); }
+    std::string engine() const override { return "auto"; }
+    std::size_t instruction_count() const override { return interp_->instruction_count(); }
+
+    double eval_point(const double* coords) override {
+        return counted([&](ir::Evaluator& e) { return e.eval_point(coords); });
+    }
+    Interval eval_box(const Interval* box) override {
+        return counted([&](ir::Evaluator& e) { return e.eval_box(box); });
+    }
+    void eval_points(const double* coords, std::size_t n, double* out) override {
+        counted([&](ir::Evaluator& e) {
+            e.eval_points(coords, n, out);
+            return 0;
+        });
+    }
+    void eval_boxes(const Interval* boxes, std::size_t n, Interval* out) override {
+        counted([&](ir::Evaluator& e) {
+            e.eval_boxes(boxes, n, out);
+            return 0;
+        });
+    }
+
+    std::unique_ptr<ir::Evaluator> clone() const override {
+        return std::make_unique<TieredEvaluator>(owner_, interp_->clone(), jit_ ? jit_->clone() : nullptr);
+    }
+
+    // Until the code is ready a pruned tape would be an interpreted one for the cell's whole subtree,
+    // which would never move to the JIT: prune nothing, the children ask again.
+    std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
+        ir::Evaluator& e = current();
+        if (&e == interp_.get() && owner_->state->phase.load(std::memory_order_acquire) != Phase::failed)
+            return nullptr;
+        e.specialize_stats = {};
+        auto p = e.specialize(box, expected_evaluations);
+        specialize_stats += e.specialize_stats;
+        return p;
+    }
+
+    void wait() {
+        std::unique_lock<std::mutex> lock(owner_->state->done_mu);
+        owner_->state->done.wait(lock, [&] {
+            const Phase p = owner_->state->phase.load(std::memory_order_acquire);
+            return p == Phase::ready || p == Phase::failed;
+        });
+    }
+
+private:
+    ir::Evaluator& current() {
+        if (jit_) return *jit_;
+        const Phase p = owner_->state->phase.load(std::memory_order_acquire);
+        if (p == Phase::ready) {
+            jit_ = owner_->state->jit->clone();
+            return *jit_;
+        }
+        if (p == Phase::failed) {
+            static std::atomic<bool> told{false}; // say it once per run
+            if (!told.exchange(true))
+                std::cerr << "frac: note: the JIT cannot be used (" << owner_->state->error
+                          << "); using the interpreter\n";
+        }
+        return *interp_;
+    }
+
+    // Runs f on the current engine and adds what it counted to this evaluator's counters (which the
+    // caller may reset at any time).
+    template <class F>
+    std::invoke_result_t<F, ir::Evaluator&> counted(F&& f) {
+        ir::Evaluator& e = current();
+        e.stats = {};
+        auto r = f(e);
+        stats.calls += e.stats.calls;
+        stats.series_terms += e.stats.series_terms;
+        stats.series_capped += e.stats.series_capped;
+        return r;
+    }
+
+    std::shared_ptr<TierOwner> owner_;
+    std::unique_ptr<ir::Evaluator> interp_;
+    std::unique_ptr<ir::Evaluator> jit_; // this evaluator's clone of the compiled code, once ready
+};
+
+} // namespace
+
+std::unique_ptr<ir::Evaluator> make_tiered(const ir::Tape& tape, const ir::EvalOptions& options,
+                                           const JitConfig& config) {
+    if (!tiers_exactly(tape))
+        throw std::invalid_argument(
+            "make_tiered: the tape has an inline kernel wider than the interpreter's");
+    auto state = std::make_shared<TierState>();
+    state->tape = tape;
+    state->options = options;
+    state->config = config;
+    auto interp = interp::make_interpreter(tape, options);
+    if (!Compiler::get().enqueue(state)) Compiler::compile(*state); // no thread to be had: compile now
+    return std::make_unique<TieredEvaluator>(std::make_shared<TierOwner>(std::move(state)), std::move(interp),
+                                             nullptr);
+}
+
+bool background_compile_pending() {
+    return Compiler::get().pending();
+}
+
+void leave_compiles_at_exit() {
+    Compiler::get().leave_at_exit();
+}
+
+void wait_for_tier(ir::Evaluator& e) {
+    if (auto* t = dynamic_cast<TieredEvaluator*>(&e)) t->wait();
+}
+
+} // namespace frac::jit

@@ -1,0 +1,128 @@
+// The tiered engine ("auto"): the interpreter's bits before the compile finishes and after it, counters
+// carried across the switch, pruning once the code is ready, covers equal to the JIT's.
+#include "engines.hpp"
+
+#include "runtime/rss.hpp"
+
+#include <stdexcept>
+
+using namespace frac;
+using namespace frac::test;
+
+namespace {
+
+const ir::Tape& only_tape(const Model& m) {
+    REQUIRE(m.tapes.size() == 1);
+    return m.tapes[0];
+}
+
+const char* const scene = R"(
+fn disk(p, c, r) = sqrt((p.x - c.x)^2 + (p.y - c.y)^2) - r;
+shape scene(x, y) over [-1, 1] × [-1, 1] =
+    min(max(disk((x, y), (0, 0), 0.8), -disk((x, y), (0.3, 0.1), 0.3)),
+        min(disk((x, y), (-0.6, 0.5), 0.2), y + 0.9 - sum(i in 0.., dz(2^i * x) / 2^i) / 4));
+)";
+
+} // namespace
+
+TEST_CASE("which tapes the JIT computes bit for bit as the interpreter", "[llvm][tiered]") {
+    // Exact operations, and powers with an integer exponent (the JIT's pow calls the core's powi).
+    CHECK(jit::tiers_exactly(only_tape(compile(scene))));
+    CHECK(jit::tiers_exactly(only_tape(compile("shape s(x, y) = y - sum(i in 0.., dz(3^i * x) / 3^i);"))));
+    CHECK(jit::tiers_exactly(only_tape(compile("shape s(x, y) = atan2(y, x) + x^3;"))));
+    // Inline kernels a few ulps wider than the core's.
+    for (const char* loose :
+         {"shape s(x, y) = sin(x) - y;", "shape s(x, y) = cos(x) - y;", "shape s(x, y) = exp(x) - y;",
+          "shape s(x, y) = tan(x) - y;", "shape s(x, y) = log(x) - y;", "shape s(x, y) = x^y;",
+          "shape s(x, y) = x^0.5 - y;", "shape s(x, y) = y - sum(i in 0.., dz(2^(i / 2) * x) / 2^i);"}) {
+        INFO(loose);
+        const Model m = compile(loose);
+        CHECK_FALSE(jit::tiers_exactly(only_tape(m)));
+        CHECK_THROWS_AS(jit::make_tiered(only_tape(m), {}, {}), std::invalid_argument);
+    }
+}
+
+TEST_CASE("a tiered evaluator gives the interpreter's bits before and after its code is ready",
+          "[llvm][tiered]") {
+    const Model m = compile(scene);
+    const ir::Tape& tape = only_tape(m);
+    BoxMaker r(7);
+    const std::vector<Interval> range{{-1, 1}, {-1, 1}};
+    std::vector<Interval> boxes;
+    std::vector<double> points;
+    constexpr std::size_t n = 3000;
+    for (std::size_t i = 0; i < n; ++i) {
+        for (const Interval& c : r.box(range)) boxes.push_back(c);
+        for (double c : r.point(range)) points.push_back(c);
+    }
+    auto reference = interp::make_interpreter(tape);
+    std::vector<Interval> want(n);
+    std::vector<double> want_points(n);
+    reference->eval_boxes(boxes.data(), n, want.data());
+    reference->eval_points(points.data(), n, want_points.data());
+
+    auto tiered = jit::make_tiered(tape, {}, {});
+    CHECK(tiered->engine() == "auto");
+    CHECK(tiered->instruction_count() == reference->instruction_count());
+    auto check_all = [&](ir::Evaluator& e, const char* when) {
+        INFO(when);
+        std::vector<Interval> got(n);
+        std::vector<double> got_points(n);
+        e.eval_boxes(boxes.data(), n, got.data());
+        e.eval_points(points.data(), n, got_points.data());
+        for (std::size_t i = 0; i < n; ++i) {
+            INFO("box " << i << " " << hex_box(&boxes[2 * i], 2));
+            REQUIRE(same(got[i], want[i]));
+            REQUIRE(same(got_points[i], want_points[i]));
+            REQUIRE(same(e.eval_box(&boxes[2 * i]), want[i]));
+        }
+    };
+    check_all(*tiered, "at once (usually interpreted)");
+    auto twin = tiered->clone();
+    jit::wait_for_tier(*tiered);
+    check_all(*tiered, "after the compile");
+    check_all(*twin, "a clone made before the compile finished");
+    // The counters add up across the switch: two passes count what two interpreted passes count.
+    auto counted = interp::make_interpreter(tape);
+    check_all(*counted, "the interpreter");
+    CHECK(tiered->stats.calls == 2 * counted->stats.calls);
+    CHECK(tiered->stats.series_terms == 2 * counted->stats.series_terms);
+    CHECK(tiered->stats.series_capped == 2 * counted->stats.series_capped);
+    CHECK(counted->stats.series_terms > 0);
+    tiered->stats = {};
+    tiered->eval_box(boxes.data());
+    CHECK(tiered->stats.calls == 1);
+}
+
+TEST_CASE("once its code is ready a tiered evaluator prunes with the JIT", "[llvm][tiered][prune]") {
+    const Model m = compile(scene);
+    auto tiered = jit::make_tiered(only_tape(m), {}, {});
+    jit::wait_for_tier(*tiered);
+    const Interval cell[2] = {{0.5, 0.55}, {-0.95, -0.9}};
+    std::shared_ptr<ir::Evaluator> pruned = tiered->specialize(cell, 1e9);
+    const ir::SpecializeStats& st = tiered->specialize_stats;
+    INFO("requests " << st.requests << " unpruned " << st.unpruned << " too little " << st.too_little
+                     << " declined " << st.declined << " compiled " << st.compiled << " fallbacks "
+                     << st.fallbacks);
+    REQUIRE(pruned);
+    CHECK(pruned->instruction_count() < tiered->instruction_count());
+    CHECK(tiered->specialize_stats.requests == 1);
+    CHECK(same(pruned->eval_box(cell), tiered->eval_box(cell)));
+}
+
+TEST_CASE("covers with the tiered engine are the JIT's, on several threads", "[llvm][tiered][rss]") {
+    const Model m = compile(scene);
+    const front::ShapeInfo& s = m.shape(0);
+    for (int threads : {1, 2}) {
+        INFO(threads << " threads");
+        auto jt = jit::make_jit(only_tape(m));
+        auto tiered = jit::make_tiered(only_tape(m), {}, {});
+        rt::RssOptions o;
+        o.depth = 9;
+        o.threads = threads;
+        const rt::RssResult a = rt::subdivide(*jt, s.box, o);
+        const rt::RssResult b = rt::subdivide(*tiered, s.box, o);
+        CHECK(rt::same_cover(a, b));
+        CHECK(b.evaluated == a.evaluated);
+    }
+}
