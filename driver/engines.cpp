@@ -59,14 +59,13 @@ std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId
                 tape.instruction_count(), jit_max_instructions);
         told = true;
     } else if (wants_jit && !prunable_and_large) {
+        jit::JitConfig config;
+        config.cache_dir = options.jit_cache_dir;
+        // The interpreter serves while LLVM starts and compiles, where that cannot change a result.
+        if (automatic && jit::tiers_exactly(tape)) return jit::make_tiered(tape, options.eval, config);
         std::string why;
         if (jit::jit_available(&why)) {
             try {
-                jit::JitConfig config;
-                config.cache_dir = options.jit_cache_dir;
-                // The interpreter serves while LLVM compiles, where that cannot change a result.
-                if (automatic && jit::tiers_exactly(tape))
-                    return jit::make_tiered(tape, options.eval, config);
                 return jit::make_jit(tape, options.eval, config);
             } catch (const jit::JitError& e) {
                 why = e.what();

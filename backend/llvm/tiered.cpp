@@ -9,6 +9,7 @@
 #include <condition_variable>
 #include <deque>
 #include <iostream>
+#include <limits>
 #include <mutex>
 #include <stdexcept>
 #include <type_traits>
@@ -16,19 +17,78 @@
 namespace frac::jit {
 
 // A thin integer exponent makes the JIT's pow call the numeric core (powi), as the interpreter does.
-// Slots that hold a thin integer wherever they are read: constants and series indices that no
-// instruction overwrites (slots are reused along the tape).
+// Which slots hold a thin integer wherever they are read: constants, series indices, and sums,
+// differences, negations and products of those while their magnitude stays below 2^53 (where interval
+// arithmetic on integers is exact, so the result stays thin). Slots are reused along the tape, so a
+// slot counts only if every instruction that writes it makes such an integer; the bounds are iterated
+// to a fixed point (a loop-carried slot whose bound keeps growing ends past 2^53, not integral).
 std::vector<bool> integral_slots(const ir::Tape& tape) {
-    std::vector<bool> integral(tape.num_slots, false);
+    constexpr double exact_limit = 9007199254740992.0; // 2^53
+    constexpr double not_integral = std::numeric_limits<double>::infinity();
+    // Per slot: -1 not written yet (by what the analysis has seen), else a bound on |value|, or
+    // not_integral.
+    std::vector<double> bound(tape.num_slots, -1.0);
+    const auto join = [&](ir::Slot slot, double b) {
+        double& cur = bound[slot];
+        const double next = b > exact_limit ? not_integral : std::max(cur, b);
+        const bool changed = next != cur;
+        cur = next;
+        return changed;
+    };
     for (const ir::TapeConst& c : tape.constants)
-        if (c.value.lo == c.value.hi && std::floor(c.value.lo) == c.value.lo) integral[c.slot] = true;
+        join(c.slot, c.value.lo == c.value.hi && std::floor(c.value.lo) == c.value.lo ? std::fabs(c.value.lo)
+                                                                                      : not_integral);
     for (const ir::TapeSeries& series : tape.series)
-        if (series.index_slot != ir::no_slot) integral[series.index_slot] = true;
+        if (series.index_slot != ir::no_slot)
+            join(series.index_slot, series.data.end == ir::infinite_end
+                                        ? static_cast<double>(series.data.start) + ir::max_terms_limit
+                                        : static_cast<double>(std::max(std::llabs(series.data.start),
+                                                                       std::llabs(series.data.end))));
+    for (const ir::Slot input : tape.input_slots)
+        if (input != ir::no_slot) join(input, not_integral);
+    for (const ir::TapeSeries& series : tape.series)
+        for (const ir::Slot state : series.state_slots) join(state, not_integral);
+    bool changed = true;
+    for (int pass = 0; changed; ++pass) {
+        changed = false;
+        for (const auto& block : tape.blocks)
+            for (const ir::Instr& ins : block) {
+                if (ins.out == ir::no_slot) continue;
+                double b = not_integral;
+                const auto arg = [&](int k) { return bound[ins.in[static_cast<std::size_t>(k)]]; };
+                switch (ins.op) {
+                case ir::Op::Add:
+                case ir::Op::Sub:
+                    if (arg(0) >= 0 && arg(1) >= 0)
+                        b = arg(0) + arg(1);
+                    else if (arg(0) < 0 || arg(1) < 0)
+                        continue; // an operand not seen yet
+                    break;
+                case ir::Op::Mul:
+                    if (arg(0) >= 0 && arg(1) >= 0)
+                        b = arg(0) * arg(1);
+                    else if (arg(0) < 0 || arg(1) < 0)
+                        continue;
+                    break;
+                case ir::Op::Neg:
+                    if (arg(0) < 0) continue;
+                    b = arg(0);
+                    break;
+                default: break;
+                }
+                // After many passes a bound still growing is a loop: give up on it.
+                changed |= join(ins.out, pass > 64 ? not_integral : b);
+            }
+    }
+    // An operand no one writes (verify_tape forbids it) proves nothing.
     for (const auto& block : tape.blocks)
         for (const ir::Instr& ins : block)
-            if (ins.out != ir::no_slot) integral[ins.out] = false;
-    for (const ir::Slot input : tape.input_slots)
-        if (input != ir::no_slot) integral[input] = false;
+            for (int k = 0; k < ir::arity(ins.op); ++k)
+                if (ins.out != ir::no_slot && ins.in[static_cast<std::size_t>(k)] != ir::no_slot &&
+                    bound[ins.in[static_cast<std::size_t>(k)]] < 0)
+                    bound[ins.out] = not_integral;
+    std::vector<bool> integral(tape.num_slots);
+    for (std::size_t k = 0; k < bound.size(); ++k) integral[k] = bound[k] >= 0 && bound[k] <= exact_limit;
     return integral;
 }
 

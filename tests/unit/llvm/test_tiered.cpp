@@ -30,6 +30,14 @@ TEST_CASE("which tapes the JIT computes bit for bit as the interpreter", "[llvm]
     CHECK(jit::tiers_exactly(only_tape(compile(scene))));
     CHECK(jit::tiers_exactly(only_tape(compile("shape s(x, y) = y - sum(i in 0.., dz(3^i * x) / 3^i);"))));
     CHECK(jit::tiers_exactly(only_tape(compile("shape s(x, y) = atan2(y, x) + x^3;"))));
+    CHECK(jit::tiers_exactly(
+        only_tape(compile("shape s(x, y) = y - sum(i in 0.., dz(3^(2 * i + 1) * x) / 3^(i + 1));"))));
+    // Every shape of the solids (the sponge's 3^(17 + k) included).
+    const Model solids = compile("import \"solids\";");
+    for (std::size_t i = 0; i < solids.tapes.size(); ++i) {
+        INFO(solids.shape(i).name);
+        CHECK(jit::tiers_exactly(solids.tapes[i]));
+    }
     // Inline kernels a few ulps wider than the core's.
     for (const char* loose :
          {"shape s(x, y) = sin(x) - y;", "shape s(x, y) = cos(x) - y;", "shape s(x, y) = exp(x) - y;",
