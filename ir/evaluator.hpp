@@ -78,6 +78,9 @@ public:
     // `box` (shared and cached: clone it for another thread). Null when nothing is pruned, when it
     // would not pay, or when the engine does not specialise.
     virtual std::shared_ptr<Evaluator> specialize(const Interval* box, double expected_evaluations);
+    // False when specialize() returns null whatever it is asked (nothing to prune, pruning off, an
+    // engine that does not specialise): callers skip asking per cell.
+    virtual bool may_specialize() const { return false; }
     // Instructions of the function this evaluator computes (its tape).
     virtual std::size_t instruction_count() const { return 0; }
 

@@ -85,6 +85,7 @@ struct Variant {
     std::vector<std::unique_ptr<ir::Evaluator>> owned;
     std::vector<ir::Evaluator*> workers; // one per thread
     double instructions = 0;             // of its function
+    bool may_specialize = false;         // its function can be pruned further
 };
 
 // One run of the subdivision. Holds the frontier of the current level (its undecided cells) and
@@ -104,6 +105,7 @@ public:
         variants_[0].workers.push_back(&f_);
         for (const auto& c : clones_) variants_[0].workers.push_back(c.get());
         variants_[0].instructions = static_cast<double>(f_.instruction_count());
+        variants_[0].may_specialize = f_.may_specialize();
         // Each thread gets a batch of its own per flush.
         flush_at_ = r_.options.batch * static_cast<std::size_t>(threads_);
         queue_.reserve(std::min<std::size_t>(flush_at_, 1 << 16));
@@ -124,11 +126,12 @@ public:
         finish_level();
         for (int k = 1; k <= depth; ++k) {
             check_budget(k, next_.size());
-            std::vector<Pos> parents;
-            parents.swap(next_);
-            release_unused(parents);
+            // The two frontiers swap buffers: no level regrows (and faults in) a fresh one.
+            parents_.swap(next_);
+            next_.clear();
+            release_unused(parents_);
             start_level(k);
-            push_children(parents);
+            push_children(parents_);
             finish_level();
         }
         for (const LevelCounts& lc : r_.levels) {
@@ -172,6 +175,9 @@ private:
     void start_level(int k) {
         level_ = k;
         n_ = grid::ipow(r_.split, k);
+        const int remaining = r_.depth - k;
+        consider_pruning_ = remaining >= std::max(1, r_.options.prune_min_remaining);
+        expected_descendants_ = expected_descendants(remaining);
         // The level's grid points per axis, computed once (each cell would otherwise compute two per
         // axis with three interval operations each); the same expression, so the same boxes.
         grid_.assign(n_ <= grid_table_limit ? static_cast<std::size_t>(d_) : 0, {});
@@ -227,38 +233,20 @@ private:
         if (queue_.size() >= flush_at_) flush();
     }
 
-    // Evaluates the queued cells of the current level in one eval_boxes call and classifies them.
+    // Evaluates the queued cells of the current level and classifies them: the cells' boxes, their
+    // evaluation and their verdicts are made per chunk on the subdivision's threads (evaluate); the
+    // counts, the frontier and the pruning requests follow in queue order, so the output does not
+    // depend on the threads.
     void flush() {
         const std::size_t m = queue_.size();
         if (m == 0) return;
-        const auto d = static_cast<std::size_t>(d_);
-        boxes_.resize(m * d);
-        out_.resize(m);
-        const auto cell_boxes = [&](std::size_t begin, std::size_t end) {
-            num::UpwardRounding up; // the cell boxes use the numeric core's directed rounding
-            for (std::size_t j = begin; j < end; ++j) {
-                const std::uint32_t pos[3] = {queue_[j].ix, queue_[j].iy, queue_[j].iz};
-                for (std::size_t a = 0; a < d; ++a) boxes_[j * d + a] = cell_interval(a, pos[a]);
-            }
-        };
-        if (threads_ == 1 || m < 2 * min_chunk) {
-            cell_boxes(0, m);
-        } else {
-            arena_.execute([&] {
-                tbb::parallel_for(
-                    tbb::blocked_range<std::size_t>(0, m, min_chunk),
-                    [&](const tbb::blocked_range<std::size_t>& r) { cell_boxes(r.begin(), r.end()); });
-            });
-        }
         evaluate(m);
 
         const bool last = level_ == r_.depth;
-        const int remaining = r_.depth - level_;
-        const bool consider_pruning = remaining >= std::max(1, r_.options.prune_min_remaining);
         LevelCounts& lc = r_.levels[static_cast<std::size_t>(level_)];
         for (std::size_t j = 0; j < m; ++j) {
             CellClass cls = CellClass::boundary;
-            switch (classify(out_[j], r_.options.closed_inside)) {
+            switch (verdict_[j]) {
             case Verdict::inside:
                 cls = CellClass::inside;
                 ++lc.inside;
@@ -272,8 +260,8 @@ private:
                 if (!last) {
                     cls = CellClass::subdivided;
                     next_.push_back(queue_[j]);
-                    if (consider_pruning)
-                        next_.back().variant = pruned_variant(queue_[j].variant, &boxes_[j * d]);
+                    if (consider_pruning_ && variants_[queue_[j].variant].may_specialize)
+                        next_.back().variant = pruned_variant(queue_[j]);
                 }
                 break;
             }
@@ -291,15 +279,21 @@ private:
         }
     }
 
-    // Evaluates boxes_[0, m) into out_, each cell with its variant's function: the cells are gathered
-    // by variant, each variant's run is cut into up to chunks_per_thread chunks per thread, all
-    // chunks run in one parallel loop, and the results are put back in place.
+    // The box of a queued cell (outward: the grid's points are enclosures).
+    void cell_box(const Pos& p, Interval* box) const {
+        const std::uint32_t pos[3] = {p.ix, p.iy, p.iz};
+        for (int a = 0; a < d_; ++a)
+            box[a] = cell_interval(static_cast<std::size_t>(a), pos[static_cast<std::size_t>(a)]);
+    }
+
+    // Gives verdict_[0, m) for the queued cells, each evaluated with its variant's function: the cells
+    // are taken in variant order (a counting sort when the batch mixes variants), each variant's run is
+    // cut into up to chunks_per_thread chunks per thread, and each chunk builds its cells' boxes,
+    // evaluates them in one call and classifies them, all chunks in one parallel loop.
     void evaluate(std::size_t m) {
         const auto d = static_cast<std::size_t>(d_);
         bool mixed = false;
         for (std::size_t j = 0; j < m && !mixed; ++j) mixed = queue_[j].variant != queue_[0].variant;
-        const Interval* boxes = boxes_.data();
-        Interval* out = out_.data();
         std::vector<std::size_t> starts{0}; // of each variant's run in the gathered order
         std::vector<std::uint32_t> run_variant;
         if (!mixed) {
@@ -320,12 +314,10 @@ private:
             }
             order_.resize(m);
             for (std::size_t j = 0; j < m; ++j) order_[offset_[queue_[j].variant]++] = j;
-            group_boxes_.resize(m * d);
-            group_out_.resize(m);
-            for (std::size_t i = 0; i < m; ++i) std::copy_n(&boxes_[order_[i] * d], d, &group_boxes_[i * d]);
-            boxes = group_boxes_.data();
-            out = group_out_.data();
         }
+        boxes_.resize(m * d);
+        out_.resize(m);
+        verdict_.resize(m);
         struct Chunk {
             std::uint32_t variant;
             std::size_t begin, end;
@@ -350,9 +342,17 @@ private:
         // threads share an evaluator, and threads that finish early take more chunks (series stop
         // after different numbers of terms in different cells). Results go by position, so the
         // output does not depend on which thread evaluated what.
+        const bool closed_inside = r_.options.closed_inside;
         const auto run_chunk = [&](const Chunk& c, std::size_t worker) {
-            variants_[c.variant].workers[worker]->eval_boxes(boxes + c.begin * d, c.end - c.begin,
-                                                             out + c.begin);
+            {
+                num::UpwardRounding up; // the cell boxes use the numeric core's directed rounding
+                for (std::size_t i = c.begin; i < c.end; ++i)
+                    cell_box(queue_[mixed ? order_[i] : i], &boxes_[i * d]);
+            }
+            variants_[c.variant].workers[worker]->eval_boxes(&boxes_[c.begin * d], c.end - c.begin,
+                                                             &out_[c.begin]);
+            for (std::size_t i = c.begin; i < c.end; ++i)
+                verdict_[mixed ? order_[i] : i] = classify(out_[i], closed_inside);
         };
         if (chunks.size() == 1 || threads_ == 1) {
             for (const Chunk& c : chunks) run_chunk(c, 0);
@@ -366,8 +366,6 @@ private:
                 });
             });
         }
-        if (mixed)
-            for (std::size_t i = 0; i < m; ++i) out_[order_[i]] = group_out_[i];
     }
 
     // Descendant evaluations of an undecided cell `remaining` levels above the depth, if the
@@ -380,30 +378,38 @@ private:
         return total;
     }
 
-    // The variant the children of an undecided cell of variant v with box `box` evaluate: a pruned
-    // function when the evaluator offers one (the same function always maps to the same variant).
-    std::uint32_t pruned_variant(std::uint32_t v, const Interval* box) {
+    // The variant the children of the undecided cell p evaluate: a pruned function when its variant's
+    // evaluator offers one (the same function always maps to the same variant).
+    std::uint32_t pruned_variant(const Pos& p) {
+        const std::uint32_t v = p.variant;
         ir::Evaluator& e = *variants_[v].workers[0];
         PruneLevel& pl = r_.prune_levels[static_cast<std::size_t>(level_)];
         ++pl.requests;
-        std::shared_ptr<ir::Evaluator> p = e.specialize(box, expected_descendants(r_.depth - level_));
-        if (!p) return v;
+        Interval box[3];
+        {
+            num::UpwardRounding up;
+            cell_box(p, box);
+        }
+        std::shared_ptr<ir::Evaluator> pruned = e.specialize(box, expected_descendants_);
+        if (!pruned) return v;
         ++pl.pruned;
-        auto [it, added] = variant_of_.try_emplace(p.get(), static_cast<std::uint32_t>(variants_.size()));
+        auto [it, added] =
+            variant_of_.try_emplace(pruned.get(), static_cast<std::uint32_t>(variants_.size()));
         if (added) {
             Variant nv;
-            nv.instructions = static_cast<double>(p->instruction_count());
+            nv.instructions = static_cast<double>(pruned->instruction_count());
+            nv.may_specialize = pruned->may_specialize();
             // An evaluator made for this cell alone (no cache holds it) serves the first thread itself.
-            const bool own = p.use_count() == 1;
+            const bool own = pruned.use_count() == 1;
             for (int t = 0; t < threads_; ++t) {
                 if (t == 0 && own) {
-                    nv.workers.push_back(p.get());
+                    nv.workers.push_back(pruned.get());
                     continue;
                 }
-                nv.owned.push_back(p->clone());
+                nv.owned.push_back(pruned->clone());
                 nv.workers.push_back(nv.owned.back().get());
             }
-            nv.function = std::move(p);
+            nv.function = std::move(pruned);
             variants_.push_back(std::move(nv));
             ++created_;
         }
@@ -459,18 +465,21 @@ private:
     // each with an evaluator per thread.
     std::vector<Variant> variants_;
     std::unordered_map<const ir::Evaluator*, std::uint32_t> variant_of_;
-    std::vector<Interval> group_boxes_, group_out_; // cells gathered by variant
-    std::vector<std::size_t> order_;                // ... their positions in the batch
-    std::vector<std::size_t> offset_;               // ... and where each variant's run starts
-    std::size_t created_ = 0;                       // pruned functions made (variants after the first)
+    std::vector<std::size_t> order_;  // cells gathered by variant: their positions in the batch
+    std::vector<std::size_t> offset_; // ... and where each variant's run starts
+    std::size_t created_ = 0;         // pruned functions made (variants after the first)
     std::size_t flush_at_ = 0;
     int level_ = 0;
     std::uint64_t n_ = 1;                     // cells per axis at level_
     std::vector<std::vector<Interval>> grid_; // grid points of the level per axis, when n_ <= limit
     std::vector<Interval> width_;             // enclosure of the root's width per axis
     std::vector<Pos> queue_;                  // cells of level_ waiting for evaluation
-    std::vector<Interval> boxes_, out_;       // batch buffers
+    std::vector<Interval> boxes_, out_;       // batch buffers (in variant order when the batch mixes them)
+    std::vector<Verdict> verdict_;            // ... the verdicts, in queue order
+    bool consider_pruning_ = false;           // the level's undecided cells ask for pruned functions
+    double expected_descendants_ = 0;         // ... for this many evaluations below each
     std::vector<Pos> next_;                   // undecided cells of level_, row-major
+    std::vector<Pos> parents_;                // ... of the level before
     Clock::time_point last_progress_;
 };
 

@@ -47,6 +47,7 @@ public:
     // A tape push: the pruned tape of the box, made for this cell's descendants alone (no cache: a
     // tape copy costs about what looking it up would). It prunes its own sub-boxes in turn, so tapes
     // shrink down the tree.
+    bool may_specialize() const override { return options_.prune && has_choices_; }
     std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
         if (!options_.prune || !has_choices_ || expected_evaluations <= interp_min_expected_evaluations)
             return nullptr;

@@ -212,11 +212,15 @@ public:
 
     // Choices are recorded with the interpreter (the generated code keeps no register file); the
     // interpreter's enclosures are the JIT's bit for bit, so both engines prune alike.
+    bool may_specialize() const override {
+        return code_->options.prune && code_->has_choices && !cache_.expired();
+    }
     std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
-        auto cache = cache_.lock();
-        if (!cache || !code_->options.prune || !code_->has_choices ||
+        if (!code_->options.prune || !code_->has_choices ||
             expected_evaluations < jit_min_expected_evaluations)
             return nullptr;
+        auto cache = cache_.lock();
+        if (!cache) return nullptr;
         const auto t0 = Clock::now();
         if (!recorder_) recorder_ = std::make_unique<interp::ChoiceRecorder>(code_->tape, code_->options);
         const std::vector<ir::Choice> choices = recorder_->record(box);

@@ -281,6 +281,8 @@ public:
         return std::make_unique<TieredEvaluator>(owner_, interp_->clone(), jit_ ? jit_->clone() : nullptr);
     }
 
+    bool may_specialize() const override { return interp_->may_specialize(); }
+
     // Until the code is ready a pruned tape would be an interpreted one for the cell's whole subtree,
     // which would never move to the JIT: prune nothing, the children ask again.
     std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {

@@ -190,6 +190,21 @@ TEST_CASE("the JIT declines to compile a pruned tape that would not repay it", "
     }
 }
 
+TEMPLATE_TEST_CASE("may_specialize says whether pruning can ever happen", "[llvm][prune]", InterpEngine,
+                   JitEngine, TieredEngine) {
+    const Model m = compile(csg_model);
+    ir::EvalOptions off;
+    off.prune = false;
+    CHECK(TestType::make(tape_of(m, "scene"))->may_specialize());
+    CHECK_FALSE(TestType::make(tape_of(m, "scene"), off)->may_specialize());
+    // The carpet alone has no min or max in its top-level code to prune.
+    const Model plain = compile("import \"fractals\"; shape c(x, y) = carpet(x, y);");
+    auto carpet = TestType::make(tape_of(plain, "c"));
+    CHECK_FALSE(carpet->may_specialize());
+    const std::vector<Interval> cell{{0.1, 0.2}, {0.1, 0.2}};
+    CHECK_FALSE(carpet->specialize(cell.data(), 1e12));
+}
+
 TEMPLATE_TEST_CASE("what pruning must not touch", "[llvm][prune]", InterpEngine, JitEngine) {
     const Model m = compile(csg_model);
     SECTION("an operand that may become empty on a sub-box is kept") {

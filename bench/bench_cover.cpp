@@ -1,0 +1,95 @@
+// What a JIT cover costs beyond evaluation, and how it scales to two threads (issue 13): the carpet's
+// RSS cover against the JIT's kernel alone on the same cells, and a deep cover on 1 and 2 threads.
+// Every variant in this one run, repetitions interleaved, medians.
+//
+//   bench_cover [depth=10] [deep_depth=12] [reps=5]
+#include "backend/llvm/jit.hpp"
+#include "bench/bench_common.hpp"
+#include "driver/pipeline.hpp"
+#include "ir/tape.hpp"
+#include "runtime/rss.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <fmt/format.h>
+#include <iostream>
+
+using namespace frac;
+
+namespace {
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+rt::RssResult cover(ir::Evaluator& e, const std::vector<ir::Interval>& box, int depth, int threads,
+                    bool keep_cells = false) {
+    rt::RssOptions o;
+    o.depth = depth;
+    o.threads = threads;
+    o.keep_cells = keep_cells;
+    return rt::subdivide(e, box, o);
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    const int depth = argc > 1 ? std::atoi(argv[1]) : 10;
+    const int deep = argc > 2 ? std::atoi(argv[2]) : 12;
+    const int reps = argc > 3 ? std::max(1, std::atoi(argv[3])) : 5;
+    auto c = driver::compile_source("bench.frac", "import \"fractals\";");
+    if (!c->ok()) {
+        std::cerr << c->diags.render(c->sources);
+        return 1;
+    }
+    const front::ShapeInfo& s = *c->module.find_shape("carpet");
+    const ir::Tape tape = ir::build_tape(c->module.graph, s.root, s.dimension);
+    auto jt = jit::make_jit(tape);
+
+    // The boxes of every cell the cover evaluates, for the kernel alone.
+    const rt::RssResult cells = cover(*jt, s.box, depth, 1, true);
+    std::vector<ir::Interval> boxes;
+    boxes.reserve(2 * cells.cells.size());
+    for (const rt::Cell& cell : cells.cells) {
+        boxes.push_back(cells.cell_interval(cell, 0));
+        boxes.push_back(cells.cell_interval(cell, 1));
+    }
+    const std::size_t n = boxes.size() / 2;
+    std::vector<ir::Interval> out(n);
+
+    std::vector<double> kernel, one, two, deep_one, deep_two;
+    std::uint64_t deep_cells = 0;
+    for (int r = 0; r < reps; ++r) {
+        auto t0 = bench::Clock::now();
+        for (std::size_t i = 0; i < n; i += 4096)
+            jt->eval_boxes(boxes.data() + 2 * i, std::min<std::size_t>(4096, n - i), out.data() + i);
+        kernel.push_back(bench::seconds_since(t0));
+        one.push_back(cover(*jt, s.box, depth, 1).seconds);
+        two.push_back(cover(*jt, s.box, depth, 2).seconds);
+        const rt::RssResult d1 = cover(*jt, s.box, deep, 1);
+        deep_one.push_back(d1.seconds);
+        deep_two.push_back(cover(*jt, s.box, deep, 2).seconds);
+        deep_cells = d1.evaluated;
+    }
+    const double ns = 1e9 / double(n);
+    const double k = median(kernel) * ns, c1 = median(one) * ns, c2 = median(two) * ns;
+    fmt::print("JIT carpet cover, depth {} ({} evaluations), median of {} (ns per evaluation)\n", depth, n,
+               reps);
+    fmt::print("  kernel alone (eval_boxes, batches of 4096)   {:8.1f}\n", k);
+    fmt::print(
+        "  cover, 1 thread                              {:8.1f}   beyond the kernel {:6.1f} ({:.0f} %)\n", c1,
+        c1 - k, 100 * (c1 - k) / c1);
+    fmt::print("  cover, 2 threads                             {:8.1f}   speed-up {:.2f}x\n", c2, c1 / c2);
+    const double t1 = median(deep_one), t2 = median(deep_two);
+    fmt::print("JIT carpet cover, depth {} ({} evaluations): 1 thread {:.3f} s, 2 threads {:.3f} s, speed-up "
+               "{:.2f}x\n",
+               deep, deep_cells, t1, t2, t1 / t2);
+    double load[3] = {0, 0, 0};
+    if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
+        if (std::fscanf(f, "%lf %lf %lf", &load[0], &load[1], &load[2]) != 3) load[0] = -1;
+        std::fclose(f);
+    }
+    fmt::print("load average {:.2f} {:.2f} {:.2f}\n", load[0], load[1], load[2]);
+    return 0;
+}
