@@ -3,6 +3,7 @@
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
+#include <oneapi/tbb/task_group.h>
 #include <thread>
 
 #include <fmt/format.h>
@@ -88,6 +89,25 @@ struct Variant {
     bool may_specialize = false;         // its function can be pruned further
 };
 
+// A chunk of a batch: cells [begin, end) of the batch in variant order, and the evaluators (one per
+// thread) of their variant.
+struct Chunk {
+    ir::Evaluator* const* workers;
+    std::size_t begin, end;
+};
+
+// Cells of one level queued for evaluation, and what evaluating them gives.
+struct Batch {
+    std::vector<Pos> cells;
+    bool mixed = false;               // of several variants: then evaluated in variant order
+    std::vector<std::size_t> order;   // ... the cells' positions in that order
+    std::vector<Interval> boxes, out; // in variant order
+    std::vector<Verdict> verdict;     // in queue order
+    std::vector<Chunk> chunks;
+    tbb::task_group group; // evaluating it in the background
+    bool running = false;
+};
+
 // One run of the subdivision. Holds the frontier of the current level (its undecided cells) and
 // the batch being filled, nothing else unless keep_cells.
 class Runner {
@@ -108,10 +128,18 @@ public:
         variants_[0].may_specialize = f_.may_specialize();
         // Each thread gets a batch of its own per flush.
         flush_at_ = r_.options.batch * static_cast<std::size_t>(threads_);
-        queue_.reserve(std::min<std::size_t>(flush_at_, 1 << 16));
+        for (Batch& b : batches_) b.cells.reserve(std::min<std::size_t>(flush_at_, 1 << 16));
     }
 
     ~Runner() {
+        // A batch may still run when an exception (a limit, a failed evaluation) ends the run.
+        for (Batch& b : batches_)
+            if (b.running) {
+                try {
+                    arena_.execute([&] { b.group.wait(); });
+                } catch (...) {
+                }
+            }
         for (const Variant& v : variants_) count_work(v);
     }
 
@@ -131,6 +159,14 @@ public:
             next_.clear();
             release_unused(parents_);
             start_level(k);
+            // Room for the level's undecided cells at once (growing by doubling would copy and
+            // fault in the frontier several times): the share undecided at the last level, plus 1/8.
+            const LevelCounts& before = r_.levels[static_cast<std::size_t>(k - 1)];
+            const double share =
+                static_cast<double>(before.undecided) / static_cast<double>(before.evaluated);
+            const double children = static_cast<double>(parents_.size()) * std::pow(r_.split, d_);
+            if (k < depth)
+                next_.reserve(static_cast<std::size_t>(std::min(children, children * share * 1.125)));
             push_children(parents_);
             finish_level();
         }
@@ -199,6 +235,7 @@ private:
 
     void finish_level() {
         flush();
+        drain();
         if (r_.options.progress) r_.options.progress(level_, r_.evaluated);
         last_progress_ = Clock::now();
     }
@@ -229,24 +266,64 @@ private:
     }
 
     void push(Pos p) {
-        queue_.push_back(p);
-        if (queue_.size() >= flush_at_) flush();
+        Batch& b = batches_[filling_];
+        b.cells.push_back(p);
+        if (b.cells.size() >= flush_at_) flush();
     }
 
-    // Evaluates the queued cells of the current level and classifies them: the cells' boxes, their
-    // evaluation and their verdicts are made per chunk on the subdivision's threads (evaluate); the
-    // counts, the frontier and the pruning requests follow in queue order, so the output does not
-    // depend on the threads.
+    // Evaluates the filled batch and classifies it. With several threads the evaluation runs in the
+    // background (each chunk builds its cells' boxes, evaluates them and gives their verdicts) while
+    // this thread takes the verdicts of the previous batch and then fills the next one: the serial
+    // work (child generation, counts, the frontier, pruning requests) overlaps the evaluation. The
+    // verdicts are taken batch by batch in queue order, so the output does not depend on the threads.
     void flush() {
-        const std::size_t m = queue_.size();
-        if (m == 0) return;
-        evaluate(m);
+        Batch& b = batches_[filling_];
+        if (b.cells.empty()) return;
+        prepare(b);
+        if (threads_ == 1 || b.chunks.size() == 1) {
+            drain();
+            for (const Chunk& c : b.chunks) run_chunk(b, c, 0);
+            take_verdicts(b);
+            return;
+        }
+        arena_.execute([&] {
+            b.group.run([this, &b] {
+                tbb::parallel_for(std::size_t{0}, b.chunks.size(), [&](std::size_t i) {
+                    const int slot = tbb::this_task_arena::current_thread_index();
+                    if (slot < 0 || slot >= threads_)
+                        throw std::logic_error("rss: a thread outside the subdivision's arena");
+                    run_chunk(b, b.chunks[i], static_cast<std::size_t>(slot));
+                });
+            });
+        });
+        b.running = true;
+        filling_ ^= 1;
+        drain_one(batches_[filling_]); // the batch before, if it still has verdicts to give
+    }
 
+    // Waits for a running batch and takes its verdicts.
+    void drain_one(Batch& b) {
+        if (!b.running) return;
+        arena_.execute([&] { b.group.wait(); });
+        b.running = false;
+        take_verdicts(b);
+    }
+
+    // Every batch's verdicts taken, oldest first (the one filling is never running).
+    void drain() {
+        drain_one(batches_[filling_ ^ 1]);
+        drain_one(batches_[filling_]);
+    }
+
+    // Counts, frontier, kept cells and pruning requests from a batch's verdicts, in queue order.
+    void take_verdicts(Batch& b) {
+        const std::size_t m = b.cells.size();
         const bool last = level_ == r_.depth;
         LevelCounts& lc = r_.levels[static_cast<std::size_t>(level_)];
         for (std::size_t j = 0; j < m; ++j) {
+            const Pos& p = b.cells[j];
             CellClass cls = CellClass::boundary;
-            switch (verdict_[j]) {
+            switch (b.verdict[j]) {
             case Verdict::inside:
                 cls = CellClass::inside;
                 ++lc.inside;
@@ -259,19 +336,18 @@ private:
                 ++lc.undecided;
                 if (!last) {
                     cls = CellClass::subdivided;
-                    next_.push_back(queue_[j]);
-                    if (consider_pruning_ && variants_[queue_[j].variant].may_specialize)
-                        next_.back().variant = pruned_variant(queue_[j]);
+                    next_.push_back(p);
+                    if (consider_pruning_ && variants_[p.variant].may_specialize)
+                        next_.back().variant = pruned_variant(p);
                 }
                 break;
             }
             if (r_.options.keep_cells)
-                r_.cells.push_back(
-                    {static_cast<std::uint8_t>(level_), cls, queue_[j].ix, queue_[j].iy, queue_[j].iz});
+                r_.cells.push_back({static_cast<std::uint8_t>(level_), cls, p.ix, p.iy, p.iz});
         }
         lc.evaluated += m;
         r_.evaluated += m;
-        queue_.clear();
+        b.cells.clear();
 
         if (r_.options.progress && Clock::now() - last_progress_ >= std::chrono::seconds(1)) {
             r_.options.progress(level_, r_.evaluated);
@@ -286,23 +362,22 @@ private:
             box[a] = cell_interval(static_cast<std::size_t>(a), pos[static_cast<std::size_t>(a)]);
     }
 
-    // Gives verdict_[0, m) for the queued cells, each evaluated with its variant's function: the cells
-    // are taken in variant order (a counting sort when the batch mixes variants), each variant's run is
-    // cut into up to chunks_per_thread chunks per thread, and each chunk builds its cells' boxes,
-    // evaluates them in one call and classifies them, all chunks in one parallel loop.
-    void evaluate(std::size_t m) {
+    // Cuts a batch into chunks: the cells are taken in variant order (a counting sort when the batch
+    // mixes variants), and each variant's run is cut into up to chunks_per_thread chunks per thread.
+    void prepare(Batch& b) {
+        const std::size_t m = b.cells.size();
         const auto d = static_cast<std::size_t>(d_);
-        bool mixed = false;
-        for (std::size_t j = 0; j < m && !mixed; ++j) mixed = queue_[j].variant != queue_[0].variant;
+        b.mixed = false;
+        for (std::size_t j = 0; j < m && !b.mixed; ++j) b.mixed = b.cells[j].variant != b.cells[0].variant;
         std::vector<std::size_t> starts{0}; // of each variant's run in the gathered order
         std::vector<std::uint32_t> run_variant;
-        if (!mixed) {
-            run_variant.push_back(queue_[0].variant);
+        if (!b.mixed) {
+            run_variant.push_back(b.cells[0].variant);
             starts.push_back(m);
         } else {
             // A counting sort by variant: linear in the cells and the variants.
             offset_.assign(variants_.size() + 1, 0);
-            for (std::size_t j = 0; j < m; ++j) ++offset_[queue_[j].variant + 1];
+            for (std::size_t j = 0; j < m; ++j) ++offset_[b.cells[j].variant + 1];
             for (std::uint32_t v = 0; v < variants_.size(); ++v) {
                 if (offset_[v + 1] == 0) {
                     offset_[v + 1] = offset_[v];
@@ -312,17 +387,13 @@ private:
                 offset_[v + 1] += offset_[v];
                 starts.push_back(offset_[v + 1]);
             }
-            order_.resize(m);
-            for (std::size_t j = 0; j < m; ++j) order_[offset_[queue_[j].variant]++] = j;
+            b.order.resize(m);
+            for (std::size_t j = 0; j < m; ++j) b.order[offset_[b.cells[j].variant]++] = j;
         }
-        boxes_.resize(m * d);
-        out_.resize(m);
-        verdict_.resize(m);
-        struct Chunk {
-            std::uint32_t variant;
-            std::size_t begin, end;
-        };
-        std::vector<Chunk> chunks;
+        b.boxes.resize(m * d);
+        b.out.resize(m);
+        b.verdict.resize(m);
+        b.chunks.clear();
         for (std::size_t r = 0; r < run_variant.size(); ++r) {
             const std::size_t n = starts[r + 1] - starts[r];
             PruneLevel& pl = r_.prune_levels[static_cast<std::size_t>(level_)];
@@ -330,42 +401,33 @@ private:
                 r_.pruned_evaluations += n;
                 pl.pruned_evaluations += n;
             }
-            pl.instructions += static_cast<double>(n) * variants_[run_variant[r]].instructions;
+            const Variant& v = variants_[run_variant[r]];
+            pl.instructions += static_cast<double>(n) * v.instructions;
             const auto k = std::max<std::size_t>(
                 1, std::min<std::size_t>(
                        threads_ == 1 ? 1 : chunks_per_thread * static_cast<std::size_t>(threads_),
                        (n + min_chunk - 1) / min_chunk));
+            // The evaluators' array, not the variant: pruning requests may add variants (moving them)
+            // while the batch runs.
             for (std::size_t c = 0; c < k; ++c)
-                chunks.push_back({run_variant[r], starts[r] + n * c / k, starts[r] + n * (c + 1) / k});
+                b.chunks.push_back({v.workers.data(), starts[r] + n * c / k, starts[r] + n * (c + 1) / k});
         }
-        // A chunk runs on the evaluator of the thread that takes it (its slot in the arena), so no two
-        // threads share an evaluator, and threads that finish early take more chunks (series stop
-        // after different numbers of terms in different cells). Results go by position, so the
-        // output does not depend on which thread evaluated what.
-        const bool closed_inside = r_.options.closed_inside;
-        const auto run_chunk = [&](const Chunk& c, std::size_t worker) {
-            {
-                num::UpwardRounding up; // the cell boxes use the numeric core's directed rounding
-                for (std::size_t i = c.begin; i < c.end; ++i)
-                    cell_box(queue_[mixed ? order_[i] : i], &boxes_[i * d]);
-            }
-            variants_[c.variant].workers[worker]->eval_boxes(&boxes_[c.begin * d], c.end - c.begin,
-                                                             &out_[c.begin]);
+    }
+
+    // A chunk runs on the evaluator of the thread that takes it (its slot in the arena), so no two
+    // threads share an evaluator, and threads that finish early take more chunks (series stop after
+    // different numbers of terms in different cells). Results go by position, so the output does not
+    // depend on which thread evaluated what.
+    void run_chunk(Batch& b, const Chunk& c, std::size_t worker) const {
+        const auto d = static_cast<std::size_t>(d_);
+        {
+            num::UpwardRounding up; // the cell boxes use the numeric core's directed rounding
             for (std::size_t i = c.begin; i < c.end; ++i)
-                verdict_[mixed ? order_[i] : i] = classify(out_[i], closed_inside);
-        };
-        if (chunks.size() == 1 || threads_ == 1) {
-            for (const Chunk& c : chunks) run_chunk(c, 0);
-        } else {
-            arena_.execute([&] {
-                tbb::parallel_for(std::size_t{0}, chunks.size(), [&](std::size_t i) {
-                    const int slot = tbb::this_task_arena::current_thread_index();
-                    if (slot < 0 || slot >= threads_)
-                        throw std::logic_error("rss: a thread outside the subdivision's arena");
-                    run_chunk(chunks[i], static_cast<std::size_t>(slot));
-                });
-            });
+                cell_box(b.cells[b.mixed ? b.order[i] : i], &b.boxes[i * d]);
         }
+        c.workers[worker]->eval_boxes(&b.boxes[c.begin * d], c.end - c.begin, &b.out[c.begin]);
+        for (std::size_t i = c.begin; i < c.end; ++i)
+            b.verdict[b.mixed ? b.order[i] : i] = classify(b.out[i], r_.options.closed_inside);
     }
 
     // Descendant evaluations of an undecided cell `remaining` levels above the depth, if the
@@ -465,21 +527,19 @@ private:
     // each with an evaluator per thread.
     std::vector<Variant> variants_;
     std::unordered_map<const ir::Evaluator*, std::uint32_t> variant_of_;
-    std::vector<std::size_t> order_;  // cells gathered by variant: their positions in the batch
-    std::vector<std::size_t> offset_; // ... and where each variant's run starts
+    std::vector<std::size_t> offset_; // where each variant's run starts in a batch
     std::size_t created_ = 0;         // pruned functions made (variants after the first)
     std::size_t flush_at_ = 0;
     int level_ = 0;
     std::uint64_t n_ = 1;                     // cells per axis at level_
     std::vector<std::vector<Interval>> grid_; // grid points of the level per axis, when n_ <= limit
     std::vector<Interval> width_;             // enclosure of the root's width per axis
-    std::vector<Pos> queue_;                  // cells of level_ waiting for evaluation
-    std::vector<Interval> boxes_, out_;       // batch buffers (in variant order when the batch mixes them)
-    std::vector<Verdict> verdict_;            // ... the verdicts, in queue order
-    bool consider_pruning_ = false;           // the level's undecided cells ask for pruned functions
-    double expected_descendants_ = 0;         // ... for this many evaluations below each
-    std::vector<Pos> next_;                   // undecided cells of level_, row-major
-    std::vector<Pos> parents_;                // ... of the level before
+    Batch batches_[2];                        // one filling, the other maybe evaluating
+    int filling_ = 0;
+    bool consider_pruning_ = false;   // the level's undecided cells ask for pruned functions
+    double expected_descendants_ = 0; // ... for this many evaluations below each
+    std::vector<Pos> next_;           // undecided cells of level_, row-major
+    std::vector<Pos> parents_;        // ... of the level before
     Clock::time_point last_progress_;
 };
 
