@@ -81,6 +81,10 @@ public:
     // False when specialize() returns null whatever it is asked (nothing to prune, pruning off, an
     // engine that does not specialise): callers skip asking per cell.
     virtual bool may_specialize() const { return false; }
+    // Whether specialize() depends only on this evaluator's function and the box, not on a state
+    // shared with its clones (a cache filled in the order of requests): then a cover asks on every
+    // thread at once, and the answers do not depend on which thread asked first.
+    virtual bool specializes_independently() const { return false; }
     // Instructions of the function this evaluator computes (its tape).
     virtual std::size_t instruction_count() const { return 0; }
 

@@ -29,9 +29,27 @@ enum class Op : std::uint8_t {
 
 enum class OpClass : std::uint8_t { leaf, arith, logic, series };
 
-int arity(Op op);
+namespace detail {
+// The opcode table's columns (ir/opcodes.def), inline: the passes over tapes ask them per instruction.
+inline constexpr std::uint8_t op_arity[] = {
+#define FRAC_OP(name, arity, text, cls) arity,
+#include "ir/opcodes.def"
+#undef FRAC_OP
+};
+inline constexpr OpClass op_classes[] = {
+#define FRAC_OP(name, arity, text, cls) OpClass::cls,
+#include "ir/opcodes.def"
+#undef FRAC_OP
+};
+} // namespace detail
+
+inline int arity(Op op) {
+    return detail::op_arity[static_cast<int>(op)];
+}
 const char* op_name(Op op);
-OpClass op_class(Op op);
+inline OpClass op_class(Op op) {
+    return detail::op_classes[static_cast<int>(op)];
+}
 inline bool is_series(Op op) {
     return op_class(op) == OpClass::series;
 }

@@ -87,6 +87,7 @@ struct Variant {
     std::vector<ir::Evaluator*> workers; // one per thread
     double instructions = 0;             // of its function
     bool may_specialize = false;         // its function can be pruned further
+    bool prune_in_chunks = false;        // ... by each thread's evaluator as it evaluates
 };
 
 // A chunk of a batch: cells [begin, end) of the batch in variant order, and the evaluators (one per
@@ -94,6 +95,7 @@ struct Variant {
 struct Chunk {
     ir::Evaluator* const* workers;
     std::size_t begin, end;
+    bool prune = false; // its undecided cells ask for pruned functions
 };
 
 // Cells of one level queued for evaluation, and what evaluating them gives.
@@ -103,6 +105,9 @@ struct Batch {
     std::vector<std::size_t> order;   // ... the cells' positions in that order
     std::vector<Interval> boxes, out; // in variant order
     std::vector<Verdict> verdict;     // in queue order
+    // Pruned functions asked for by the chunks, in queue order (for variants whose evaluators answer
+    // independently of each other: the cells of a level ask on every thread at once).
+    std::vector<std::shared_ptr<ir::Evaluator>> pruned;
     std::vector<Chunk> chunks;
     tbb::task_group group; // evaluating it in the background
     bool running = false;
@@ -126,6 +131,7 @@ public:
         for (const auto& c : clones_) variants_[0].workers.push_back(c.get());
         variants_[0].instructions = static_cast<double>(f_.instruction_count());
         variants_[0].may_specialize = f_.may_specialize();
+        variants_[0].prune_in_chunks = f_.may_specialize() && f_.specializes_independently();
         // Each thread gets a batch of its own per flush.
         flush_at_ = r_.options.batch * static_cast<std::size_t>(threads_);
         for (Batch& b : batches_) b.cells.reserve(std::min<std::size_t>(flush_at_, 1 << 16));
@@ -274,8 +280,10 @@ private:
     // Evaluates the filled batch and classifies it. With several threads the evaluation runs in the
     // background (each chunk builds its cells' boxes, evaluates them and gives their verdicts) while
     // this thread takes the verdicts of the previous batch and then fills the next one: the serial
-    // work (child generation, counts, the frontier, pruning requests) overlaps the evaluation. The
-    // verdicts are taken batch by batch in queue order, so the output does not depend on the threads.
+    // work (child generation, counts, the frontier, pruning requests of JIT variants) overlaps the
+    // evaluation. Interpreted variants prune in the chunks, each thread with its own evaluator (a tape
+    // push depends on nothing else). The verdicts and the pruned functions are taken batch by batch in
+    // queue order, so the output does not depend on the threads.
     void flush() {
         Batch& b = batches_[filling_];
         if (b.cells.empty()) return;
@@ -337,7 +345,10 @@ private:
                 if (!last) {
                     cls = CellClass::subdivided;
                     next_.push_back(p);
-                    if (consider_pruning_ && variants_[p.variant].may_specialize)
+                    const Variant& v = variants_[p.variant];
+                    if (consider_pruning_ && v.prune_in_chunks)
+                        next_.back().variant = adopt(p.variant, std::move(b.pruned[j]));
+                    else if (consider_pruning_ && v.may_specialize)
                         next_.back().variant = pruned_variant(p);
                 }
                 break;
@@ -409,8 +420,11 @@ private:
                        (n + min_chunk - 1) / min_chunk));
             // The evaluators' array, not the variant: pruning requests may add variants (moving them)
             // while the batch runs.
+            const bool prune = consider_pruning_ && level_ < r_.depth && v.prune_in_chunks;
+            if (prune && b.pruned.size() != m) b.pruned.assign(m, nullptr);
             for (std::size_t c = 0; c < k; ++c)
-                b.chunks.push_back({v.workers.data(), starts[r] + n * c / k, starts[r] + n * (c + 1) / k});
+                b.chunks.push_back(
+                    {v.workers.data(), starts[r] + n * c / k, starts[r] + n * (c + 1) / k, prune});
         }
     }
 
@@ -428,6 +442,12 @@ private:
         c.workers[worker]->eval_boxes(&b.boxes[c.begin * d], c.end - c.begin, &b.out[c.begin]);
         for (std::size_t i = c.begin; i < c.end; ++i)
             b.verdict[b.mixed ? b.order[i] : i] = classify(b.out[i], r_.options.closed_inside);
+        if (!c.prune) return;
+        for (std::size_t i = c.begin; i < c.end; ++i) {
+            const std::size_t j = b.mixed ? b.order[i] : i;
+            if (b.verdict[j] == Verdict::undecided)
+                b.pruned[j] = c.workers[worker]->specialize(&b.boxes[i * d], expected_descendants_);
+        }
     }
 
     // Descendant evaluations of an undecided cell `remaining` levels above the depth, if the
@@ -445,14 +465,19 @@ private:
     std::uint32_t pruned_variant(const Pos& p) {
         const std::uint32_t v = p.variant;
         ir::Evaluator& e = *variants_[v].workers[0];
-        PruneLevel& pl = r_.prune_levels[static_cast<std::size_t>(level_)];
-        ++pl.requests;
         Interval box[3];
         {
             num::UpwardRounding up;
             cell_box(p, box);
         }
-        std::shared_ptr<ir::Evaluator> pruned = e.specialize(box, expected_descendants_);
+        return adopt(v, e.specialize(box, expected_descendants_));
+    }
+
+    // The variant of the pruned function a cell of variant v asked for (null: v), made when it is new;
+    // the request is counted here, in queue order.
+    std::uint32_t adopt(std::uint32_t v, std::shared_ptr<ir::Evaluator> pruned) {
+        PruneLevel& pl = r_.prune_levels[static_cast<std::size_t>(level_)];
+        ++pl.requests;
         if (!pruned) return v;
         ++pl.pruned;
         auto [it, added] =
@@ -461,6 +486,7 @@ private:
             Variant nv;
             nv.instructions = static_cast<double>(pruned->instruction_count());
             nv.may_specialize = pruned->may_specialize();
+            nv.prune_in_chunks = nv.may_specialize && pruned->specializes_independently();
             // An evaluator made for this cell alone (no cache holds it) serves the first thread itself.
             const bool own = pruned.use_count() == 1;
             for (int t = 0; t < threads_; ++t) {

@@ -48,6 +48,7 @@ public:
     // tape copy costs about what looking it up would). It prunes its own sub-boxes in turn, so tapes
     // shrink down the tree.
     bool may_specialize() const override { return options_.prune && has_choices_; }
+    bool specializes_independently() const override { return true; } // a tape push, no cache
     std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
         if (!options_.prune || !has_choices_ || expected_evaluations <= interp_min_expected_evaluations)
             return nullptr;
