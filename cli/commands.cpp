@@ -229,6 +229,7 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
     const rt::RssResult full = cover(box, o.depth, o.split, true, engine.threads, *eval, o.limits);
+    eval.reset(); // no more evaluation: a background compile not started yet is dropped
     std::cerr << fmt::format(
         "{}: depth {}, {} boxes evaluated: {} inside, {} outside, {} boundary; {:.3f} s\n", s.name, o.depth,
         full.evaluated, full.inside, full.outside, full.boundary, full.seconds);

@@ -5,6 +5,7 @@
 #include <pthread.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <deque>
@@ -137,6 +138,10 @@ struct TierState {
 // (leave_compiles_at_exit: the CLI, which must not wait for LLVM after its work is done).
 class Compiler {
 public:
+    // A compile starts this long after its evaluator was made: a job that is over by then (most of
+    // `frac test`'s, small pictures) never shares the cores with LLVM; a long one loses this much.
+    static constexpr std::chrono::milliseconds start_delay{10};
+
     static Compiler& get() {
         static Compiler c;
         return c;
@@ -147,7 +152,7 @@ public:
         std::lock_guard<std::mutex> lock(mu_);
         start_locked();
         if (!started_) return false;
-        jobs_.push_back(s);
+        jobs_.push_back({s, std::chrono::steady_clock::now() + start_delay});
         wake_.notify_one();
         return true;
     }
@@ -155,7 +160,7 @@ public:
     // The evaluators of `s` are gone.
     void forget(const TierState* s) {
         std::unique_lock<std::mutex> lock(mu_);
-        std::erase_if(jobs_, [&](const std::shared_ptr<TierState>& j) { return j.get() == s; });
+        std::erase_if(jobs_, [&](const Job& j) { return j.state.get() == s; });
         if (!leave_at_exit_) finished_.wait(lock, [&] { return current_ != s; });
     }
 
@@ -223,7 +228,12 @@ private:
                 s = nullptr; // released under the lock: forget() may be waiting to free it
                 wake_.wait(lock, [&] { return stop_ || !jobs_.empty(); });
                 if (stop_) return;
-                s = std::move(jobs_.front());
+                const auto due = jobs_.front().due;
+                if (std::chrono::steady_clock::now() < due) {
+                    wake_.wait_until(lock, due); // then look again: the job may be gone
+                    continue;
+                }
+                s = std::move(jobs_.front().state);
                 jobs_.pop_front();
                 current_ = s.get();
             }
@@ -233,7 +243,11 @@ private:
 
     std::mutex mu_;
     std::condition_variable wake_, finished_;
-    std::deque<std::shared_ptr<TierState>> jobs_;
+    struct Job {
+        std::shared_ptr<TierState> state;
+        std::chrono::steady_clock::time_point due; // not started before
+    };
+    std::deque<Job> jobs_;
     const TierState* current_ = nullptr; // being compiled
     bool stop_ = false, started_ = false, failed_to_start_ = false, leave_at_exit_ = false;
     pthread_t thread_{};
