@@ -90,27 +90,45 @@ struct Variant {
     bool prune_in_chunks = false;        // ... by each thread's evaluator as it evaluates
 };
 
-// A chunk of a batch: cells [begin, end) of the batch in variant order, and the evaluators (one per
-// thread) of their variant.
+// A chunk of a batch: cells [begin, end) of the batch.
 struct Chunk {
-    ir::Evaluator* const* workers;
     std::size_t begin, end;
-    bool prune = false; // its undecided cells ask for pruned functions
 };
 
-// Cells of one level queued for evaluation, and what evaluating them gives.
+// Cells [first, first + cells.size()) of a level, in row-major order, and what evaluating them gives.
 struct Batch {
-    std::vector<Pos> cells;
-    bool mixed = false;               // of several variants: then evaluated in variant order
-    std::vector<std::size_t> order;   // ... the cells' positions in that order
-    std::vector<Interval> boxes, out; // in variant order
-    std::vector<Verdict> verdict;     // in queue order
-    // Pruned functions asked for by the chunks, in queue order (for variants whose evaluators answer
-    // independently of each other: the cells of a level ask on every thread at once).
+    std::uint64_t first = 0;
+    std::vector<Pos> cells; // made by the chunks
+    std::vector<Interval> boxes, out;
+    std::vector<Verdict> verdict;
+    // Pruned functions asked for by the chunks (for variants whose evaluators answer independently of
+    // each other: the cells of a level ask on every thread at once).
     std::vector<std::shared_ptr<ir::Evaluator>> pruned;
     std::vector<Chunk> chunks;
     tbb::task_group group; // evaluating it in the background
     bool running = false;
+};
+
+// The children of one row of parents (in 3D: of one row, in child layer cz): `count` parents from
+// parents_[parent] give count * split^2 consecutive cells of the level, from cell `first`.
+struct ChildBlock {
+    std::size_t parent;
+    std::uint64_t count;
+    std::uint32_t cz;
+    std::uint64_t first;
+};
+
+// What a level's cells need of their variant, fixed for the level (pruning requests add variants for
+// the next level while it runs).
+struct LevelVariant {
+    ir::Evaluator* const* workers; // one per thread
+    bool prune;                    // undecided cells ask for pruned functions in the chunks
+};
+
+// Per-thread room for a chunk whose cells evaluate several variants.
+struct ChunkScratch {
+    std::vector<std::uint32_t> order;
+    std::vector<Interval> boxes, out;
 };
 
 // One run of the subdivision. Holds the frontier of the current level (its undecided cells) and
@@ -134,7 +152,6 @@ public:
         variants_[0].prune_in_chunks = f_.may_specialize() && f_.specializes_independently();
         // Each thread gets a batch of its own per flush.
         flush_at_ = r_.options.batch * static_cast<std::size_t>(threads_);
-        for (Batch& b : batches_) b.cells.reserve(std::min<std::size_t>(flush_at_, 1 << 16));
     }
 
     ~Runner() {
@@ -156,8 +173,7 @@ public:
         last_progress_ = Clock::now();
 
         start_level(0);
-        push({0, 0, 0});
-        finish_level();
+        evaluate_level();
         for (int k = 1; k <= depth; ++k) {
             check_budget(k, next_.size());
             // The two frontiers swap buffers: no level regrows (and faults in) a fresh one.
@@ -173,8 +189,7 @@ public:
             const double children = static_cast<double>(parents_.size()) * std::pow(r_.split, d_);
             if (k < depth)
                 next_.reserve(static_cast<std::size_t>(std::min(children, children * share * 1.125)));
-            push_children(parents_);
-            finish_level();
+            evaluate_level();
         }
         for (const LevelCounts& lc : r_.levels) {
             r_.inside += lc.inside;
@@ -220,6 +235,17 @@ private:
         const int remaining = r_.depth - k;
         consider_pruning_ = remaining >= std::max(1, r_.options.prune_min_remaining);
         expected_descendants_ = expected_descendants(remaining);
+        if (k == 0)
+            level_cells_ = 1;
+        else
+            plan_children();
+        level_variants_.clear();
+        prune_in_chunks_ = false;
+        for (const Variant& v : variants_) {
+            const bool prune = consider_pruning_ && k < r_.depth && v.prune_in_chunks;
+            level_variants_.push_back({v.workers.data(), prune});
+            prune_in_chunks_ |= prune;
+        }
         // The level's grid points per axis, computed once (each cell would otherwise compute two per
         // axis with three interval operations each); the same expression, so the same boxes.
         grid_.assign(n_ <= grid_table_limit ? static_cast<std::size_t>(d_) : 0, {});
@@ -239,55 +265,77 @@ private:
                 i + 1 >= n_ ? root.hi : std::min(root.hi, grid_[axis][i + 1].hi)};
     }
 
-    void finish_level() {
-        flush();
+    // Evaluates the level's cells, from the plan of start_level, batch by batch.
+    void evaluate_level() {
+        for (std::uint64_t c = 0; c < level_cells_; c += flush_at_)
+            flush(c, static_cast<std::size_t>(std::min<std::uint64_t>(flush_at_, level_cells_ - c)));
         drain();
         if (r_.options.progress) r_.options.progress(level_, r_.evaluated);
         last_progress_ = Clock::now();
     }
 
-    // Children of `parents` (the undecided cells of the previous level, row-major) in row-major
-    // order: the children of one parent row fill `split` child rows, each running over all the
-    // parents of the row; likewise for slabs of constant iz in 3D. Linear time, no sort.
-    void push_children(const std::vector<Pos>& parents) {
-        const auto s = static_cast<std::uint32_t>(r_.split);
-        const std::uint32_t sz = d_ == 3 ? s : 1;
-        for (std::size_t slab = 0; slab < parents.size();) {
+    // The order of the level's cells: the children of the previous level's undecided cells (row-major)
+    // in row-major order. The children of one parent row fill `split` child rows, each running over all
+    // the parents of the row; likewise for slabs of constant iz in 3D. Linear in the rows.
+    void plan_children() {
+        blocks_.clear();
+        const std::uint64_t s = static_cast<std::uint64_t>(r_.split);
+        const std::uint32_t sz = d_ == 3 ? static_cast<std::uint32_t>(s) : 1;
+        std::uint64_t first = 0;
+        for (std::size_t slab = 0; slab < parents_.size();) {
             std::size_t slab_end = slab;
-            while (slab_end < parents.size() && parents[slab_end].iz == parents[slab].iz) ++slab_end;
-            for (std::uint32_t cz = 0; cz < sz; ++cz) {
+            while (slab_end < parents_.size() && parents_[slab_end].iz == parents_[slab].iz) ++slab_end;
+            for (std::uint32_t cz = 0; cz < sz; ++cz)
                 for (std::size_t row = slab; row < slab_end;) {
                     std::size_t row_end = row;
-                    while (row_end < slab_end && parents[row_end].iy == parents[row].iy) ++row_end;
-                    for (std::uint32_t cy = 0; cy < s; ++cy)
-                        for (std::size_t p = row; p < row_end; ++p)
-                            for (std::uint32_t cx = 0; cx < s; ++cx)
-                                push({parents[p].ix * s + cx, parents[p].iy * s + cy, parents[p].iz * sz + cz,
-                                      parents[p].variant});
+                    while (row_end < slab_end && parents_[row_end].iy == parents_[row].iy) ++row_end;
+                    blocks_.push_back({row, row_end - row, cz, first});
+                    first += (row_end - row) * s * s;
                     row = row_end;
                 }
-            }
             slab = slab_end;
+        }
+        level_cells_ = first;
+    }
+
+    // Cells [c, c + n) of the level, in its order (plan_children; level 0 is the root).
+    void children(std::uint64_t c, std::size_t n, Pos* out) const {
+        if (level_ == 0) {
+            std::fill_n(out, n, Pos{0, 0, 0, 0});
+            return;
+        }
+        const auto s = static_cast<std::uint32_t>(r_.split);
+        const std::uint32_t sz = d_ == 3 ? s : 1;
+        auto block = std::upper_bound(blocks_.begin(), blocks_.end(), c,
+                                      [](std::uint64_t v, const ChildBlock& b) { return v < b.first; }) -
+                     1;
+        // Position in the block: child row cy, parent pi of the row, child column cx; then counted on.
+        const std::uint64_t j = c - block->first, row = block->count * s;
+        auto cy = static_cast<std::uint32_t>(j / row);
+        std::uint64_t pi = (j % row) / s;
+        auto cx = static_cast<std::uint32_t>((j % row) % s);
+        for (std::size_t k = 0; k < n; ++k) {
+            const Pos& p = parents_[block->parent + pi];
+            out[k] = {p.ix * s + cx, p.iy * s + cy, p.iz * sz + block->cz, p.variant};
+            if (++cx < s) continue;
+            cx = 0;
+            if (++pi < block->count) continue;
+            pi = 0;
+            if (++cy < s) continue;
+            cy = 0;
+            ++block;
         }
     }
 
-    void push(Pos p) {
+    // Evaluates cells [first, first + m) of the level and classifies them. With several threads the
+    // batch runs in the background (each chunk makes its cells, their boxes, evaluates and classifies
+    // them, and asks for pruned functions of interpreted variants: a tape push depends on nothing
+    // shared) while this thread takes the verdicts of the previous batch: counts, the next frontier,
+    // kept cells, pruning requests of JIT variants. The verdicts and the pruned functions are taken
+    // batch by batch in the level's order, so the output does not depend on the threads.
+    void flush(std::uint64_t first, std::size_t m) {
         Batch& b = batches_[filling_];
-        b.cells.push_back(p);
-        if (b.cells.size() >= flush_at_) flush();
-    }
-
-    // Evaluates the filled batch and classifies it. With several threads the evaluation runs in the
-    // background (each chunk builds its cells' boxes, evaluates them and gives their verdicts) while
-    // this thread takes the verdicts of the previous batch and then fills the next one: the serial
-    // work (child generation, counts, the frontier, pruning requests of JIT variants) overlaps the
-    // evaluation. Interpreted variants prune in the chunks, each thread with its own evaluator (a tape
-    // push depends on nothing else). The verdicts and the pruned functions are taken batch by batch in
-    // queue order, so the output does not depend on the threads.
-    void flush() {
-        Batch& b = batches_[filling_];
-        if (b.cells.empty()) return;
-        prepare(b);
+        prepare(b, first, m);
         if (threads_ == 1 || b.chunks.size() == 1) {
             drain();
             for (const Chunk& c : b.chunks) run_chunk(b, c, 0);
@@ -317,19 +365,25 @@ private:
         take_verdicts(b);
     }
 
-    // Every batch's verdicts taken, oldest first (the one filling is never running).
+    // Every batch's verdicts taken, oldest first (the one to fill next is never running).
     void drain() {
         drain_one(batches_[filling_ ^ 1]);
         drain_one(batches_[filling_]);
     }
 
-    // Counts, frontier, kept cells and pruning requests from a batch's verdicts, in queue order.
+    // Counts, frontier, kept cells and pruning requests from a batch's verdicts, in the level's order.
     void take_verdicts(Batch& b) {
         const std::size_t m = b.cells.size();
         const bool last = level_ == r_.depth;
         LevelCounts& lc = r_.levels[static_cast<std::size_t>(level_)];
+        PruneLevel& pl = r_.prune_levels[static_cast<std::size_t>(level_)];
         for (std::size_t j = 0; j < m; ++j) {
             const Pos& p = b.cells[j];
+            if (p.variant != 0) {
+                ++r_.pruned_evaluations;
+                ++pl.pruned_evaluations;
+            }
+            pl.instructions += variants_[p.variant].instructions;
             CellClass cls = CellClass::boundary;
             switch (b.verdict[j]) {
             case Verdict::inside:
@@ -358,7 +412,6 @@ private:
         }
         lc.evaluated += m;
         r_.evaluated += m;
-        b.cells.clear();
 
         if (r_.options.progress && Clock::now() - last_progress_ >= std::chrono::seconds(1)) {
             r_.options.progress(level_, r_.evaluated);
@@ -366,87 +419,74 @@ private:
         }
     }
 
-    // The box of a queued cell (outward: the grid's points are enclosures).
+    // The box of a cell (outward: the grid's points are enclosures).
     void cell_box(const Pos& p, Interval* box) const {
         const std::uint32_t pos[3] = {p.ix, p.iy, p.iz};
         for (int a = 0; a < d_; ++a)
             box[a] = cell_interval(static_cast<std::size_t>(a), pos[static_cast<std::size_t>(a)]);
     }
 
-    // Cuts a batch into chunks: the cells are taken in variant order (a counting sort when the batch
-    // mixes variants), and each variant's run is cut into up to chunks_per_thread chunks per thread.
-    void prepare(Batch& b) {
-        const std::size_t m = b.cells.size();
+    // Sizes a batch for cells [first, first + m) and cuts it into up to chunks_per_thread chunks per
+    // thread.
+    void prepare(Batch& b, std::uint64_t first, std::size_t m) {
         const auto d = static_cast<std::size_t>(d_);
-        b.mixed = false;
-        for (std::size_t j = 0; j < m && !b.mixed; ++j) b.mixed = b.cells[j].variant != b.cells[0].variant;
-        std::vector<std::size_t> starts{0}; // of each variant's run in the gathered order
-        std::vector<std::uint32_t> run_variant;
-        if (!b.mixed) {
-            run_variant.push_back(b.cells[0].variant);
-            starts.push_back(m);
-        } else {
-            // A counting sort by variant: linear in the cells and the variants.
-            offset_.assign(variants_.size() + 1, 0);
-            for (std::size_t j = 0; j < m; ++j) ++offset_[b.cells[j].variant + 1];
-            for (std::uint32_t v = 0; v < variants_.size(); ++v) {
-                if (offset_[v + 1] == 0) {
-                    offset_[v + 1] = offset_[v];
-                    continue;
-                }
-                run_variant.push_back(v);
-                offset_[v + 1] += offset_[v];
-                starts.push_back(offset_[v + 1]);
-            }
-            b.order.resize(m);
-            for (std::size_t j = 0; j < m; ++j) b.order[offset_[b.cells[j].variant]++] = j;
-        }
+        b.first = first;
+        b.cells.resize(m);
         b.boxes.resize(m * d);
         b.out.resize(m);
         b.verdict.resize(m);
+        if (prune_in_chunks_) b.pruned.assign(m, nullptr);
+        const auto k = std::max<std::size_t>(
+            1,
+            std::min<std::size_t>(threads_ == 1 ? 1 : chunks_per_thread * static_cast<std::size_t>(threads_),
+                                  (m + min_chunk - 1) / min_chunk));
         b.chunks.clear();
-        for (std::size_t r = 0; r < run_variant.size(); ++r) {
-            const std::size_t n = starts[r + 1] - starts[r];
-            PruneLevel& pl = r_.prune_levels[static_cast<std::size_t>(level_)];
-            if (run_variant[r] != 0) {
-                r_.pruned_evaluations += n;
-                pl.pruned_evaluations += n;
-            }
-            const Variant& v = variants_[run_variant[r]];
-            pl.instructions += static_cast<double>(n) * v.instructions;
-            const auto k = std::max<std::size_t>(
-                1, std::min<std::size_t>(
-                       threads_ == 1 ? 1 : chunks_per_thread * static_cast<std::size_t>(threads_),
-                       (n + min_chunk - 1) / min_chunk));
-            // The evaluators' array, not the variant: pruning requests may add variants (moving them)
-            // while the batch runs.
-            const bool prune = consider_pruning_ && level_ < r_.depth && v.prune_in_chunks;
-            if (prune && b.pruned.size() != m) b.pruned.assign(m, nullptr);
-            for (std::size_t c = 0; c < k; ++c)
-                b.chunks.push_back(
-                    {v.workers.data(), starts[r] + n * c / k, starts[r] + n * (c + 1) / k, prune});
-        }
+        for (std::size_t c = 0; c < k; ++c) b.chunks.push_back({m * c / k, m * (c + 1) / k});
     }
 
-    // A chunk runs on the evaluator of the thread that takes it (its slot in the arena), so no two
+    // A chunk runs on the evaluators of the thread that takes it (its slot in the arena), so no two
     // threads share an evaluator, and threads that finish early take more chunks (series stop after
-    // different numbers of terms in different cells). Results go by position, so the output does not
-    // depend on which thread evaluated what.
+    // different numbers of terms in different cells). Its cells are evaluated with one call per variant
+    // they use. Results go by position, so the output does not depend on which thread did what.
     void run_chunk(Batch& b, const Chunk& c, std::size_t worker) const {
         const auto d = static_cast<std::size_t>(d_);
+        const std::size_t n = c.end - c.begin;
+        children(b.first + c.begin, n, &b.cells[c.begin]);
         {
             num::UpwardRounding up; // the cell boxes use the numeric core's directed rounding
-            for (std::size_t i = c.begin; i < c.end; ++i)
-                cell_box(b.cells[b.mixed ? b.order[i] : i], &b.boxes[i * d]);
+            for (std::size_t i = c.begin; i < c.end; ++i) cell_box(b.cells[i], &b.boxes[i * d]);
         }
-        c.workers[worker]->eval_boxes(&b.boxes[c.begin * d], c.end - c.begin, &b.out[c.begin]);
+        const std::uint32_t v0 = b.cells[c.begin].variant;
+        bool one_variant = true;
+        for (std::size_t i = c.begin; i < c.end && one_variant; ++i) one_variant = b.cells[i].variant == v0;
+        if (one_variant) {
+            level_variants_[v0].workers[worker]->eval_boxes(&b.boxes[c.begin * d], n, &b.out[c.begin]);
+        } else {
+            thread_local ChunkScratch s;
+            s.order.resize(n);
+            for (std::size_t i = 0; i < n; ++i) s.order[i] = static_cast<std::uint32_t>(c.begin + i);
+            std::stable_sort(s.order.begin(), s.order.end(), [&](std::uint32_t x, std::uint32_t y) {
+                return b.cells[x].variant < b.cells[y].variant;
+            });
+            s.boxes.resize(n * d);
+            s.out.resize(n);
+            for (std::size_t i = 0; i < n; ++i) std::copy_n(&b.boxes[s.order[i] * d], d, &s.boxes[i * d]);
+            for (std::size_t run = 0; run < n;) {
+                const std::uint32_t v = b.cells[s.order[run]].variant;
+                std::size_t end = run;
+                while (end < n && b.cells[s.order[end]].variant == v) ++end;
+                level_variants_[v].workers[worker]->eval_boxes(&s.boxes[run * d], end - run, &s.out[run]);
+                run = end;
+            }
+            for (std::size_t i = 0; i < n; ++i) b.out[s.order[i]] = s.out[i];
+        }
         for (std::size_t i = c.begin; i < c.end; ++i)
-            b.verdict[b.mixed ? b.order[i] : i] = classify(b.out[i], r_.options.closed_inside);
-        if (!c.prune) return;
+            b.verdict[i] = classify(b.out[i], r_.options.closed_inside);
+        if (!prune_in_chunks_) return;
         for (std::size_t i = c.begin; i < c.end; ++i) {
-            const std::size_t j = b.mixed ? b.order[i] : i;
-            if (b.verdict[j] == Verdict::undecided)
-                b.pruned[j] = c.workers[worker]->specialize(&b.boxes[i * d], expected_descendants_);
+            const LevelVariant& v = level_variants_[b.cells[i].variant];
+            if (v.prune && b.verdict[i] == Verdict::undecided)
+                b.pruned[i] = v.workers[worker]->specialize(&b.boxes[i * d], expected_descendants_);
         }
     }
 
@@ -553,8 +593,7 @@ private:
     // each with an evaluator per thread.
     std::vector<Variant> variants_;
     std::unordered_map<const ir::Evaluator*, std::uint32_t> variant_of_;
-    std::vector<std::size_t> offset_; // where each variant's run starts in a batch
-    std::size_t created_ = 0;         // pruned functions made (variants after the first)
+    std::size_t created_ = 0; // pruned functions made (variants after the first)
     std::size_t flush_at_ = 0;
     int level_ = 0;
     std::uint64_t n_ = 1;                     // cells per axis at level_
@@ -562,6 +601,10 @@ private:
     std::vector<Interval> width_;             // enclosure of the root's width per axis
     Batch batches_[2];                        // one filling, the other maybe evaluating
     int filling_ = 0;
+    std::vector<ChildBlock> blocks_; // the order of the level's cells (plan_children)
+    std::uint64_t level_cells_ = 0;  // ... and their number
+    std::vector<LevelVariant> level_variants_;
+    bool prune_in_chunks_ = false;    // some of the level's cells prune in the chunks
     bool consider_pruning_ = false;   // the level's undecided cells ask for pruned functions
     double expected_descendants_ = 0; // ... for this many evaluations below each
     std::vector<Pos> next_;           // undecided cells of level_, row-major
