@@ -70,6 +70,17 @@ int run_check(const std::string& file, const std::string& emit, const std::strin
     return 0;
 }
 
+namespace {
+
+// Engine options for an evaluator that only covers evaluate: they call its checkpoints, so "auto" may
+// tier every tape (backend/llvm/tiered.hpp).
+EngineOptions for_covers(EngineOptions engine) {
+    engine.checkpoints = true;
+    return engine;
+}
+
+} // namespace
+
 int run_eval(const std::string& file, const std::string& shape, const std::string& at, const std::string& box,
              const EngineOptions& engine) {
     auto c = compile_or_report(file);
@@ -226,7 +237,7 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
         throw UsageError(fmt::format("shape '{}' is 3D: draw a section with --slice z=VALUE, or a relief "
                                      "(shaded depth image) as .png",
                                      s.name));
-    auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
+    auto eval = make_evaluator(c->module, s.root, s.dimension, for_covers(engine));
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
     const rt::RssResult full = cover(box, o.depth, o.split, true, engine.threads, *eval, o.limits);
     eval.reset(); // no more evaluation: a background compile not started yet is dropped
@@ -279,7 +290,7 @@ int run_dimension(const std::string& file, const std::string& shape, int from, i
     if (const front::AutomatonInfo* a = c->module.find_automaton(shape))
         return automaton_dimension(*a, from, to);
     const front::ShapeInfo& s = pick_shape(*c, shape);
-    auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
+    auto eval = make_evaluator(c->module, s.root, s.dimension, for_covers(engine));
     const rt::RssResult r = cover(s.box, to, split, false, engine.threads, *eval, limits);
     rt::DimensionEstimate d;
     try {
@@ -317,7 +328,7 @@ int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions&
     if (s.dimension != 3)
         throw UsageError(fmt::format("shape '{}' is {}D; meshes are of 3D shapes (frac render draws 2D ones)",
                                      s.name, s.dimension));
-    auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
+    auto eval = make_evaluator(c->module, s.root, s.dimension, for_covers(engine));
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
     // A mesh is of the closed solid {f <= 0}: cells whose faces lie on its surface are inside.
     const rt::RssResult r = cover(box, o.depth, o.split, true, engine.threads, *eval, o.limits, true);

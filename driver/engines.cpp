@@ -63,6 +63,8 @@ std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId
         config.cache_dir = options.jit_cache_dir;
         // The interpreter serves while LLVM starts and compiles, where that cannot change a result.
         if (automatic && jit::tiers_exactly(tape)) return jit::make_tiered(tape, options.eval, config);
+        if (automatic && options.checkpoints)
+            return jit::make_tiered(tape, options.eval, config, jit::TierSwitch::checkpoints);
         std::string why;
         if (jit::jit_available(&why)) {
             try {

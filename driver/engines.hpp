@@ -20,6 +20,9 @@ struct EngineOptions {
     int threads = 0;                              // subdivision threads; 0: all cores
     std::size_t max_compile_instructions = 20000; // aot: FRAC_MAX_COMPILE_INSTRUCTIONS (cli/session.hpp)
     std::string jit_cache_dir; // the JIT's on-disk cache of machine code; empty: none (cli/session.hpp)
+    // The caller calls Evaluator::checkpoint (a cover): then "auto" tiers every tape, switching those
+    // whose JIT bits differ from the interpreter's at a checkpoint; else it compiles those first.
+    bool checkpoints = false;
 };
 
 // A user-facing run-time failure (I/O, a computation that cannot be done): message and exit code 1.

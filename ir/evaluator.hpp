@@ -85,6 +85,12 @@ public:
     // shared with its clones (a cache filled in the order of requests): then a cover asks on every
     // thread at once, and the answers do not depend on which thread asked first.
     virtual bool specializes_independently() const { return false; }
+
+    // A point of the caller's work that depends neither on threads nor on timing: a cover calls it on
+    // each of its evaluators at the start of every level, with the cells evaluated so far. A tiered
+    // evaluator whose two engines' bits may differ changes engine only here (backend/llvm/tiered.hpp),
+    // so that the output does not depend on when its compile finished.
+    virtual void checkpoint(std::uint64_t evaluated) {}
     // Instructions of the function this evaluator computes (its tape).
     virtual std::size_t instruction_count() const { return 0; }
 

@@ -239,6 +239,10 @@ private:
             level_cells_ = 1;
         else
             plan_children();
+        // The evaluators' checkpoint (a tiered one may change engine here): the same cells evaluated,
+        // whatever the threads.
+        for (const Variant& v : variants_)
+            for (ir::Evaluator* w : v.workers) w->checkpoint(r_.evaluated);
         level_variants_.clear();
         prune_in_chunks_ = false;
         for (const Variant& v : variants_) {

@@ -265,8 +265,9 @@ struct TierOwner {
 class TieredEvaluator final : public ir::Evaluator {
 public:
     TieredEvaluator(std::shared_ptr<TierOwner> owner, std::unique_ptr<ir::Evaluator> interp,
-                    std::unique_ptr<ir::Evaluator> jit)
-        : owner_(std::move(owner)), interp_(std::move(interp)), jit_(std::move(jit)) {}
+                    std::unique_ptr<ir::Evaluator> jit, std::uint64_t switch_after)
+        : owner_(std::move(owner)), interp_(std::move(interp)), jit_(std::move(jit)),
+          switch_after_(switch_after) {}
 
     int dimension() const override { return interp_->dimension(); }
     std::string engine() const override { return "auto"; }
@@ -292,7 +293,8 @@ public:
     }
 
     std::unique_ptr<ir::Evaluator> clone() const override {
-        return std::make_unique<TieredEvaluator>(owner_, interp_->clone(), jit_ ? jit_->clone() : nullptr);
+        return std::make_unique<TieredEvaluator>(owner_, interp_->clone(), jit_ ? jit_->clone() : nullptr,
+                                                 switch_after_);
     }
 
     bool may_specialize() const override { return interp_->may_specialize(); }
@@ -309,6 +311,15 @@ public:
         return p;
     }
 
+    void checkpoint(std::uint64_t evaluated) override {
+        if (switch_after_ == when_ready || jit_ || evaluated < switch_after_) return;
+        wait();
+        if (owner_->state->phase.load(std::memory_order_acquire) == Phase::ready)
+            jit_ = owner_->state->jit->clone();
+        else
+            tell_failure();
+    }
+
     void wait() {
         std::unique_lock<std::mutex> lock(owner_->state->done_mu);
         owner_->state->done.wait(lock, [&] {
@@ -319,19 +330,21 @@ public:
 
 private:
     ir::Evaluator& current() {
-        if (jit_) return *jit_;
+        if (jit_ || switch_after_ != when_ready) return jit_ ? *jit_ : *interp_;
         const Phase p = owner_->state->phase.load(std::memory_order_acquire);
         if (p == Phase::ready) {
             jit_ = owner_->state->jit->clone();
             return *jit_;
         }
-        if (p == Phase::failed) {
-            static std::atomic<bool> told{false}; // say it once per run
-            if (!told.exchange(true))
-                std::cerr << "frac: note: the JIT cannot be used (" << owner_->state->error
-                          << "); using the interpreter\n";
-        }
+        if (p == Phase::failed) tell_failure();
         return *interp_;
+    }
+
+    void tell_failure() const {
+        static std::atomic<bool> told{false}; // say it once per run
+        if (!told.exchange(true))
+            std::cerr << "frac: note: the JIT cannot be used (" << owner_->state->error
+                      << "); using the interpreter\n";
     }
 
     // Runs f on the current engine and adds what it counted to this evaluator's counters (which the
@@ -349,14 +362,23 @@ private:
 
     std::shared_ptr<TierOwner> owner_;
     std::unique_ptr<ir::Evaluator> interp_;
-    std::unique_ptr<ir::Evaluator> jit_; // this evaluator's clone of the compiled code, once ready
+    std::unique_ptr<ir::Evaluator> jit_; // this evaluator's clone of the compiled code, once switched
+    static constexpr std::uint64_t when_ready = 0; // switch_after_ of TierSwitch::when_ready
+    std::uint64_t switch_after_;                   // else: the checkpoint's cells that switch
 };
 
 } // namespace
 
+std::uint64_t checkpoint_evaluations(const ir::Tape& tape) {
+    constexpr double interp_ns_per_cost = 40, compile_ns_fixed = 15e6, compile_ns_per_cost = 0.4e6;
+    const double cost = std::max(1.0, ir::tape_cost(tape));
+    return static_cast<std::uint64_t>(
+        std::max(1.0, (compile_ns_fixed + compile_ns_per_cost * cost) / (interp_ns_per_cost * cost)));
+}
+
 std::unique_ptr<ir::Evaluator> make_tiered(const ir::Tape& tape, const ir::EvalOptions& options,
-                                           const JitConfig& config) {
-    if (!tiers_exactly(tape))
+                                           const JitConfig& config, TierSwitch when) {
+    if (when == TierSwitch::when_ready && !tiers_exactly(tape))
         throw std::invalid_argument(
             "make_tiered: the tape has an inline kernel wider than the interpreter's");
     auto state = std::make_shared<TierState>();
@@ -365,8 +387,9 @@ std::unique_ptr<ir::Evaluator> make_tiered(const ir::Tape& tape, const ir::EvalO
     state->config = config;
     auto interp = interp::make_interpreter(tape, options);
     if (!Compiler::get().enqueue(state)) Compiler::compile(*state); // no thread to be had: compile now
-    return std::make_unique<TieredEvaluator>(std::make_shared<TierOwner>(std::move(state)), std::move(interp),
-                                             nullptr);
+    return std::make_unique<TieredEvaluator>(
+        std::make_shared<TierOwner>(std::move(state)), std::move(interp), nullptr,
+        when == TierSwitch::when_ready ? 0 : checkpoint_evaluations(tape));
 }
 
 bool background_compile_pending() {

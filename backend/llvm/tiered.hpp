@@ -3,10 +3,12 @@
 // as it is ready. The default engine of the command line ("auto"), so that a small job never waits
 // for the compiler and a large one gets the JIT's speed.
 //
-// Outputs must not depend on when the compile finishes, so a tape is tiered only where the JIT's
-// enclosures are the interpreter's bit for bit (`tiers_exactly`): sin, cos, exp, tan, log and pow
-// have inline kernels a few ulps wider than the numeric core's, and tapes with them are compiled
-// before evaluation starts, as with the "jit" engine.
+// Outputs must not depend on when the compile finishes. Where the JIT's enclosures are the
+// interpreter's bit for bit (`tiers_exactly`), an evaluator switches at its first call after the code
+// is ready. Elsewhere (sin, cos, exp, tan, log and pow have inline kernels a few ulps wider than the
+// numeric core's) it switches only at a checkpoint of the caller's work (Evaluator::checkpoint: a
+// cover's level boundary) once the work done has passed an estimate of the compile's cost, waiting
+// for the code there if need be: the same point whatever the threads and the timing.
 #pragma once
 
 #include "backend/llvm/jit.hpp"
@@ -17,13 +19,23 @@ namespace frac::jit {
 // bit as the interpreter does (no loose inline kernel).
 bool tiers_exactly(const ir::Tape& tape);
 
-// An evaluator that interprets the tape until its compiled code is ready, then runs that. The
-// compile is queued on one background thread shared by the process (one compile at a time; a job
-// whose evaluators are all gone is dropped). Until the code is ready, specialize() prunes nothing
-// (the children of a cell ask again). When compiling fails, the evaluator stays interpreted and
-// says so once on stderr. Requires tiers_exactly(tape) (std::invalid_argument otherwise).
+// When a tiered evaluator moves to the compiled code.
+enum class TierSwitch {
+    when_ready, // at its first call once the code is ready (requires tiers_exactly)
+    checkpoints // at the first checkpoint with at least checkpoint_evaluations(tape) cells done
+};
+
+// An evaluator that interprets the tape until it switches to the compiled code. The compile is
+// queued on one background thread shared by the process (one compile at a time; a job whose
+// evaluators are all gone is dropped). Until the switch, specialize() prunes nothing (the children
+// of a cell ask again). When compiling fails, the evaluator stays interpreted and says so once on
+// stderr. TierSwitch::when_ready requires tiers_exactly(tape) (std::invalid_argument otherwise).
 std::unique_ptr<ir::Evaluator> make_tiered(const ir::Tape& tape, const ir::EvalOptions& options,
-                                           const JitConfig& config);
+                                           const JitConfig& config, TierSwitch when = TierSwitch::when_ready);
+
+// Cells evaluated after which interpreting has cost about what compiling costs (measured rates: the
+// interpreter about 40 ns per unit of tape cost and box, LLVM about 15 ms plus 0.4 ms per unit).
+std::uint64_t checkpoint_evaluations(const ir::Tape& tape);
 
 // When the last evaluator of a tape goes, its queued compile is dropped and one in progress is waited
 // for: LLVM's static objects must not be destroyed under it at exit. A program that promises to end

@@ -4,7 +4,9 @@
 
 #include "runtime/rss.hpp"
 
+#include <chrono>
 #include <stdexcept>
+#include <thread>
 
 using namespace frac;
 using namespace frac::test;
@@ -133,4 +135,62 @@ TEST_CASE("covers with the tiered engine are the JIT's, on several threads", "[l
         CHECK(rt::same_cover(a, b));
         CHECK(b.evaluated == a.evaluated);
     }
+}
+
+TEST_CASE("a tape with loose kernels changes engine only at a checkpoint past its threshold",
+          "[llvm][tiered]") {
+    const Model m =
+        compile("shape s(x, y) over [-3, 3] × [-3, 3] = sin(3 * x) * cos(2 * y) + exp(x / 4) - 1.2;");
+    const ir::Tape& tape = only_tape(m);
+    REQUIRE_FALSE(jit::tiers_exactly(tape));
+    BoxMaker r(11);
+    const std::vector<Interval> range{{-3, 3}, {-3, 3}};
+    std::vector<Interval> boxes;
+    constexpr std::size_t n = 2000;
+    for (std::size_t i = 0; i < n; ++i)
+        for (const Interval& c : r.box(range)) boxes.push_back(c);
+    std::vector<Interval> by_interp(n), by_jit(n), got(n);
+    interp::make_interpreter(tape)->eval_boxes(boxes.data(), n, by_interp.data());
+    jit::make_jit(tape)->eval_boxes(boxes.data(), n, by_jit.data());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < n; ++i) differ += !same(by_interp[i], by_jit[i]);
+    REQUIRE(differ > 0); // the kernels' ulps: the test could not tell the engines apart otherwise
+
+    auto tiered = jit::make_tiered(tape, {}, {}, jit::TierSwitch::checkpoints);
+    const std::uint64_t threshold = jit::checkpoint_evaluations(tape);
+    REQUIRE(threshold > 1);
+    const auto all_same = [&](const std::vector<Interval>& want) {
+        tiered->eval_boxes(boxes.data(), n, got.data());
+        for (std::size_t i = 0; i < n; ++i)
+            if (!same(got[i], want[i])) return false;
+        return true;
+    };
+    // Interpreted, however long the compile has had, until a checkpoint has passed the threshold.
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    CHECK(all_same(by_interp));
+    tiered->checkpoint(threshold - 1);
+    CHECK(all_same(by_interp));
+    CHECK_FALSE(tiered->specialize(boxes.data(), 1e9)); // nothing pruned before the switch
+    tiered->checkpoint(threshold);
+    CHECK(all_same(by_jit));
+    CHECK(tiered->clone()->eval_box(boxes.data()) == by_jit[0]);
+}
+
+TEST_CASE("covers with checkpoints are the same on any threads and in every run", "[llvm][tiered][rss]") {
+    const Model m =
+        compile("shape s(x, y) over [-3, 3] × [-3, 3] = sin(3 * x) * cos(2 * y) + exp(x / 4) - 1.2;");
+    const ir::Tape& tape = only_tape(m);
+    rt::RssOptions o;
+    o.depth = 12;
+    o.keep_cells = true;
+    std::vector<rt::RssResult> covers;
+    for (int threads : {1, 2, 2, 1}) {
+        auto tiered = jit::make_tiered(tape, {}, {}, jit::TierSwitch::checkpoints);
+        o.threads = threads;
+        covers.push_back(rt::subdivide(*tiered, m.shape(0).box, o));
+        INFO("run " << covers.size() << ", " << threads << " threads");
+        CHECK(rt::same_cover(covers.front(), covers.back()));
+    }
+    // Past the threshold: the switch happened inside these covers.
+    CHECK(covers.front().evaluated > 2 * jit::checkpoint_evaluations(tape));
 }
