@@ -93,6 +93,9 @@ struct Variant {
 // A chunk of a batch: cells [begin, end) of the batch.
 struct Chunk {
     std::size_t begin, end;
+    // What its cells gave: counts, and (from begin in Batch::undecided) its undecided cells.
+    std::uint64_t inside = 0, outside = 0, undecided = 0, pruned_cells = 0;
+    double instructions = 0; // of the functions its cells evaluated
 };
 
 // Cells [first, first + cells.size()) of a level, in row-major order, and what evaluating them gives.
@@ -101,6 +104,8 @@ struct Batch {
     std::vector<Pos> cells; // made by the chunks
     std::vector<Interval> boxes, out;
     std::vector<Verdict> verdict;
+    std::vector<std::uint32_t> undecided; // each chunk's undecided cells, from its begin
+    std::vector<Cell> kept;               // the cells as kept (keep_cells)
     // Pruned functions asked for by the chunks (for variants whose evaluators answer independently of
     // each other: the cells of a level ask on every thread at once).
     std::vector<std::shared_ptr<ir::Evaluator>> pruned;
@@ -123,6 +128,7 @@ struct ChildBlock {
 struct LevelVariant {
     ir::Evaluator* const* workers; // one per thread
     bool prune;                    // undecided cells ask for pruned functions in the chunks
+    double instructions;           // of its function
 };
 
 // Per-thread room for a chunk whose cells evaluate several variants.
@@ -247,7 +253,7 @@ private:
         prune_in_chunks_ = false;
         for (const Variant& v : variants_) {
             const bool prune = consider_pruning_ && k < r_.depth && v.prune_in_chunks;
-            level_variants_.push_back({v.workers.data(), prune});
+            level_variants_.push_back({v.workers.data(), prune, v.instructions});
             prune_in_chunks_ |= prune;
         }
         // The level's grid points per axis, computed once (each cell would otherwise compute two per
@@ -342,7 +348,7 @@ private:
         prepare(b, first, m);
         if (threads_ == 1 || b.chunks.size() == 1) {
             drain();
-            for (const Chunk& c : b.chunks) run_chunk(b, c, 0);
+            for (Chunk& c : b.chunks) run_chunk(b, c, 0);
             take_verdicts(b);
             return;
         }
@@ -375,47 +381,36 @@ private:
         drain_one(batches_[filling_]);
     }
 
-    // Counts, frontier, kept cells and pruning requests from a batch's verdicts, in the level's order.
+    // Counts, frontier, kept cells and pruning requests from a batch's chunks, in the level's order.
     void take_verdicts(Batch& b) {
-        const std::size_t m = b.cells.size();
         const bool last = level_ == r_.depth;
         LevelCounts& lc = r_.levels[static_cast<std::size_t>(level_)];
         PruneLevel& pl = r_.prune_levels[static_cast<std::size_t>(level_)];
-        for (std::size_t j = 0; j < m; ++j) {
-            const Pos& p = b.cells[j];
-            if (p.variant != 0) {
-                ++r_.pruned_evaluations;
-                ++pl.pruned_evaluations;
-            }
-            pl.instructions += variants_[p.variant].instructions;
-            CellClass cls = CellClass::boundary;
-            switch (b.verdict[j]) {
-            case Verdict::inside:
-                cls = CellClass::inside;
-                ++lc.inside;
-                break;
-            case Verdict::outside:
-                cls = CellClass::outside;
-                ++lc.outside;
-                break;
-            case Verdict::undecided:
-                ++lc.undecided;
-                if (!last) {
-                    cls = CellClass::subdivided;
-                    next_.push_back(p);
-                    const Variant& v = variants_[p.variant];
-                    if (consider_pruning_ && v.prune_in_chunks)
-                        next_.back().variant = adopt(p.variant, std::move(b.pruned[j]));
-                    else if (consider_pruning_ && v.may_specialize)
-                        next_.back().variant = pruned_variant(p);
-                }
-                break;
-            }
+        for (const Chunk& c : b.chunks) {
+            lc.inside += c.inside;
+            lc.outside += c.outside;
+            lc.undecided += c.undecided;
+            r_.pruned_evaluations += c.pruned_cells;
+            pl.pruned_evaluations += c.pruned_cells;
+            pl.instructions += c.instructions;
             if (r_.options.keep_cells)
-                r_.cells.push_back({static_cast<std::uint8_t>(level_), cls, p.ix, p.iy, p.iz});
+                r_.cells.insert(r_.cells.end(), b.kept.begin() + static_cast<std::ptrdiff_t>(c.begin),
+                                b.kept.begin() + static_cast<std::ptrdiff_t>(c.end));
+            if (last) continue;
+            for (std::size_t u = c.begin; u < c.begin + c.undecided; ++u) {
+                const std::uint32_t j = b.undecided[u];
+                const Pos& p = b.cells[j];
+                next_.push_back(p);
+                if (!consider_pruning_) continue;
+                const Variant& v = variants_[p.variant];
+                if (v.prune_in_chunks)
+                    next_.back().variant = adopt(p.variant, std::move(b.pruned[j]));
+                else if (v.may_specialize)
+                    next_.back().variant = pruned_variant(p);
+            }
         }
-        lc.evaluated += m;
-        r_.evaluated += m;
+        lc.evaluated += b.cells.size();
+        r_.evaluated += b.cells.size();
 
         if (r_.options.progress && Clock::now() - last_progress_ >= std::chrono::seconds(1)) {
             r_.options.progress(level_, r_.evaluated);
@@ -439,6 +434,8 @@ private:
         b.boxes.resize(m * d);
         b.out.resize(m);
         b.verdict.resize(m);
+        b.undecided.resize(m);
+        if (r_.options.keep_cells) b.kept.resize(m);
         if (prune_in_chunks_) b.pruned.assign(m, nullptr);
         const auto k = std::max<std::size_t>(
             1,
@@ -452,7 +449,7 @@ private:
     // threads share an evaluator, and threads that finish early take more chunks (series stop after
     // different numbers of terms in different cells). Its cells are evaluated with one call per variant
     // they use. Results go by position, so the output does not depend on which thread did what.
-    void run_chunk(Batch& b, const Chunk& c, std::size_t worker) const {
+    void run_chunk(Batch& b, Chunk& c, std::size_t worker) const {
         const auto d = static_cast<std::size_t>(d_);
         const std::size_t n = c.end - c.begin;
         children(b.first + c.begin, n, &b.cells[c.begin]);
@@ -484,8 +481,29 @@ private:
             }
             for (std::size_t i = 0; i < n; ++i) b.out[s.order[i]] = s.out[i];
         }
-        for (std::size_t i = c.begin; i < c.end; ++i)
-            b.verdict[i] = classify(b.out[i], r_.options.closed_inside);
+        // Verdicts, counts, kept cells and the undecided ones, in order: taking them is then a few copies.
+        const bool last = level_ == r_.depth;
+        c.inside = c.outside = c.undecided = c.pruned_cells = 0;
+        c.instructions = 0;
+        for (std::size_t i = c.begin; i < c.end; ++i) {
+            const Pos& p = b.cells[i];
+            const Verdict v = classify(b.out[i], r_.options.closed_inside);
+            b.verdict[i] = v;
+            c.pruned_cells += p.variant != 0;
+            c.instructions += level_variants_[p.variant].instructions;
+            CellClass cls = CellClass::boundary;
+            if (v == Verdict::inside) {
+                cls = CellClass::inside;
+                ++c.inside;
+            } else if (v == Verdict::outside) {
+                cls = CellClass::outside;
+                ++c.outside;
+            } else {
+                if (!last) cls = CellClass::subdivided;
+                b.undecided[c.begin + c.undecided++] = static_cast<std::uint32_t>(i);
+            }
+            if (r_.options.keep_cells) b.kept[i] = {static_cast<std::uint8_t>(level_), cls, p.ix, p.iy, p.iz};
+        }
         if (!prune_in_chunks_) return;
         for (std::size_t i = c.begin; i < c.end; ++i) {
             const LevelVariant& v = level_variants_[b.cells[i].variant];
