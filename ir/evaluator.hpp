@@ -78,6 +78,12 @@ public:
     // `box` (shared and cached: clone it for another thread). Null when nothing is pruned, when it
     // would not pay, or when the engine does not specialise.
     virtual std::shared_ptr<Evaluator> specialize(const Interval* box, double expected_evaluations);
+    // specialize(), when this evaluator's last evaluation was eval_box(box): an engine that keeps the
+    // values of that evaluation records the choices from them instead of evaluating again.
+    virtual std::shared_ptr<Evaluator> specialize_after_eval(const Interval* box,
+                                                             double expected_evaluations) {
+        return specialize(box, expected_evaluations);
+    }
     // False when specialize() returns null whatever it is asked (nothing to prune, pruning off, an
     // engine that does not specialise): callers skip asking per cell.
     virtual bool may_specialize() const { return false; }

@@ -461,7 +461,8 @@ private:
         bool one_variant = true;
         for (std::size_t i = c.begin; i < c.end && one_variant; ++i) one_variant = b.cells[i].variant == v0;
         if (one_variant) {
-            level_variants_[v0].workers[worker]->eval_boxes(&b.boxes[c.begin * d], n, &b.out[c.begin]);
+            evaluate_run(level_variants_[v0], worker, &b.boxes[c.begin * d], n, &b.out[c.begin], b, nullptr,
+                         c.begin);
         } else {
             thread_local ChunkScratch s;
             s.order.resize(n);
@@ -476,7 +477,8 @@ private:
                 const std::uint32_t v = b.cells[s.order[run]].variant;
                 std::size_t end = run;
                 while (end < n && b.cells[s.order[end]].variant == v) ++end;
-                level_variants_[v].workers[worker]->eval_boxes(&s.boxes[run * d], end - run, &s.out[run]);
+                evaluate_run(level_variants_[v], worker, &s.boxes[run * d], end - run, &s.out[run], b,
+                             &s.order[run], 0);
                 run = end;
             }
             for (std::size_t i = 0; i < n; ++i) b.out[s.order[i]] = s.out[i];
@@ -504,11 +506,25 @@ private:
             }
             if (r_.options.keep_cells) b.kept[i] = {static_cast<std::uint8_t>(level_), cls, p.ix, p.iy, p.iz};
         }
-        if (!prune_in_chunks_) return;
-        for (std::size_t i = c.begin; i < c.end; ++i) {
-            const LevelVariant& v = level_variants_[b.cells[i].variant];
-            if (v.prune && b.verdict[i] == Verdict::undecided)
-                b.pruned[i] = v.workers[worker]->specialize(&b.boxes[i * d], expected_descendants_);
+    }
+
+    // Evaluates n boxes of one variant into out. A variant that prunes in the chunks evaluates them one
+    // by one, and an undecided cell asks for its pruned function from the values its evaluation left
+    // (Evaluator::specialize_after_eval: no second evaluation). Cell k of the run is cell
+    // index[k] (or first + k) of the batch.
+    void evaluate_run(const LevelVariant& v, std::size_t worker, const Interval* boxes, std::size_t n,
+                      Interval* out, Batch& b, const std::uint32_t* index, std::size_t first) const {
+        ir::Evaluator& e = *v.workers[worker];
+        if (!v.prune) {
+            e.eval_boxes(boxes, n, out);
+            return;
+        }
+        const auto d = static_cast<std::size_t>(d_);
+        for (std::size_t k = 0; k < n; ++k) {
+            out[k] = e.eval_box(boxes + k * d);
+            if (classify(out[k], r_.options.closed_inside) == Verdict::undecided)
+                b.pruned[index ? index[k] : first + k] =
+                    e.specialize_after_eval(boxes + k * d, expected_descendants_);
         }
     }
 

@@ -44,16 +44,27 @@ public:
         return ir::record_choices(tape_, boxes_.data());
     }
 
+    // The register file still holds the values of eval_box(box).
+    std::shared_ptr<ir::Evaluator> specialize_after_eval(const Interval* box,
+                                                         double expected_evaluations) override {
+        return push(box, expected_evaluations, true);
+    }
+
     // A tape push: the pruned tape of the box, made for this cell's descendants alone (no cache: a
     // tape copy costs about what looking it up would). It prunes its own sub-boxes in turn, so tapes
     // shrink down the tree.
     bool may_specialize() const override { return options_.prune && has_choices_; }
     bool specializes_independently() const override { return true; } // a tape push, no cache
     std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
+        return push(box, expected_evaluations, false);
+    }
+
+    std::shared_ptr<ir::Evaluator> push(const Interval* box, double expected_evaluations, bool evaluated) {
         if (!options_.prune || !has_choices_ || expected_evaluations <= interp_min_expected_evaluations)
             return nullptr;
         const auto t0 = std::chrono::steady_clock::now();
-        const std::vector<ir::Choice> choices = record(box);
+        const std::vector<ir::Choice> choices =
+            evaluated ? ir::record_choices(tape_, boxes_.data()) : record(box);
         const auto t1 = std::chrono::steady_clock::now();
         specialize_stats.record_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();
         ++specialize_stats.requests;

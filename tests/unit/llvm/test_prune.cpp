@@ -190,6 +190,28 @@ TEST_CASE("the JIT declines to compile a pruned tape that would not repay it", "
     }
 }
 
+TEST_CASE("the interpreter prunes from the values its last evaluation left", "[llvm][prune]") {
+    const Model m = compile(csg_model);
+    auto a = InterpEngine::make(tape_of(m, "scene"));
+    auto b = InterpEngine::make(tape_of(m, "scene"));
+    BoxMaker r(5);
+    int pruned = 0;
+    for (int k = 0; k < 200; ++k) {
+        const std::vector<Interval> box = sub_box(r, {{0, 2}, {0, 1}});
+        const Interval value = a->eval_box(box.data());
+        auto after = a->specialize_after_eval(box.data(), 1e12);
+        auto fresh = b->specialize(box.data(), 1e12);
+        REQUIRE(bool(after) == bool(fresh));
+        if (!after) continue;
+        ++pruned;
+        CHECK(after->instruction_count() == fresh->instruction_count());
+        CHECK(same(after->eval_box(box.data()), fresh->eval_box(box.data())));
+        CHECK(same(after->eval_box(box.data()), value));
+    }
+    CHECK(pruned > 20);
+    CHECK(a->stats.calls == 200); // no evaluation of its own
+}
+
 TEMPLATE_TEST_CASE("may_specialize says whether pruning can ever happen", "[llvm][prune]", InterpEngine,
                    JitEngine, TieredEngine) {
     const Model m = compile(csg_model);
