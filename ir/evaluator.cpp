@@ -16,6 +16,13 @@ std::shared_ptr<Evaluator> Evaluator::specialize(const Interval*, double) {
     return nullptr;
 }
 
+EvalStats& EvalStats::operator+=(const EvalStats& o) {
+    calls += o.calls;
+    series_terms += o.series_terms;
+    series_capped += o.series_capped;
+    return *this;
+}
+
 SpecializeStats& SpecializeStats::operator+=(const SpecializeStats& o) {
     requests += o.requests;
     unpruned += o.unpruned;

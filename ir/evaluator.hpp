@@ -31,6 +31,8 @@ struct EvalStats {
     std::uint64_t calls = 0;         // point or box evaluations
     std::uint64_t series_terms = 0;  // series terms evaluated in total
     std::uint64_t series_capped = 0; // series stopped by the term limit, not by resolution
+
+    EvalStats& operator+=(const EvalStats& o);
 };
 
 // What min/max pruning did (ir/specialize.hpp), counted by the evaluator that was asked.

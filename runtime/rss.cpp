@@ -103,7 +103,6 @@ struct Batch {
     std::uint64_t first = 0;
     std::vector<Pos> cells; // made by the chunks
     std::vector<Interval> boxes, out;
-    std::vector<Verdict> verdict;
     std::vector<std::uint32_t> undecided; // each chunk's undecided cells, from its begin
     std::vector<Cell> kept;               // the cells as kept (keep_cells)
     // Pruned functions asked for by the chunks (for variants whose evaluators answer independently of
@@ -433,7 +432,6 @@ private:
         b.cells.resize(m);
         b.boxes.resize(m * d);
         b.out.resize(m);
-        b.verdict.resize(m);
         b.undecided.resize(m);
         if (r_.options.keep_cells) b.kept.resize(m);
         if (prune_in_chunks_) b.pruned.assign(m, nullptr);
@@ -490,7 +488,6 @@ private:
         for (std::size_t i = c.begin; i < c.end; ++i) {
             const Pos& p = b.cells[i];
             const Verdict v = classify(b.out[i], r_.options.closed_inside);
-            b.verdict[i] = v;
             c.pruned_cells += p.variant != 0;
             c.instructions += level_variants_[p.variant].instructions;
             CellClass cls = CellClass::boundary;
@@ -586,9 +583,7 @@ private:
     void count_work(const Variant& v) {
         for (ir::Evaluator* w : v.workers) {
             if (w == &f_) continue;
-            f_.stats.calls += w->stats.calls;
-            f_.stats.series_terms += w->stats.series_terms;
-            f_.stats.series_capped += w->stats.series_capped;
+            f_.stats += w->stats;
             f_.specialize_stats += w->specialize_stats;
             w->stats = {};
             w->specialize_stats = {};

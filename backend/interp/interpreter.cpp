@@ -44,7 +44,12 @@ public:
         return ir::record_choices(tape_, boxes_.data());
     }
 
-    // The register file still holds the values of eval_box(box).
+    bool may_specialize() const override { return options_.prune && has_choices_; }
+    bool specializes_independently() const override { return true; } // a tape push, no cache
+    std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
+        return push(box, expected_evaluations, false);
+    }
+    // The register file still holds the values of eval_box(box): no second evaluation.
     std::shared_ptr<ir::Evaluator> specialize_after_eval(const Interval* box,
                                                          double expected_evaluations) override {
         return push(box, expected_evaluations, true);
@@ -52,13 +57,7 @@ public:
 
     // A tape push: the pruned tape of the box, made for this cell's descendants alone (no cache: a
     // tape copy costs about what looking it up would). It prunes its own sub-boxes in turn, so tapes
-    // shrink down the tree.
-    bool may_specialize() const override { return options_.prune && has_choices_; }
-    bool specializes_independently() const override { return true; } // a tape push, no cache
-    std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
-        return push(box, expected_evaluations, false);
-    }
-
+    // shrink down the tree. `evaluated`: the register file holds the box's values already.
     std::shared_ptr<ir::Evaluator> push(const Interval* box, double expected_evaluations, bool evaluated) {
         if (!options_.prune || !has_choices_ || expected_evaluations <= interp_min_expected_evaluations)
             return nullptr;

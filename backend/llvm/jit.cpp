@@ -284,9 +284,7 @@ private:
         if (!interp_) interp_ = interp::make_interpreter(code_->tape, code_->options);
         interp_->stats = {};
         const Interval r = interp_->eval_box(box);
-        stats.calls += interp_->stats.calls;
-        stats.series_terms += interp_->stats.series_terms;
-        stats.series_capped += interp_->stats.series_capped;
+        stats += interp_->stats;
         return r;
     }
 

@@ -17,6 +17,8 @@
 
 namespace frac::jit {
 
+namespace {
+
 // A thin integer exponent makes the JIT's pow call the numeric core (powi), as the interpreter does.
 // Which slots hold a thin integer wherever they are read: constants, series indices, and sums,
 // differences, negations and products of those while their magnitude stays below 2^53 (where interval
@@ -92,6 +94,8 @@ std::vector<bool> integral_slots(const ir::Tape& tape) {
     for (std::size_t k = 0; k < bound.size(); ++k) integral[k] = bound[k] >= 0 && bound[k] <= exact_limit;
     return integral;
 }
+
+} // namespace
 
 bool tiers_exactly(const ir::Tape& tape) {
     const std::vector<bool> integral = integral_slots(tape);
@@ -354,9 +358,7 @@ private:
         ir::Evaluator& e = current();
         e.stats = {};
         auto r = f(e);
-        stats.calls += e.stats.calls;
-        stats.series_terms += e.stats.series_terms;
-        stats.series_capped += e.stats.series_capped;
+        stats += e.stats;
         return r;
     }
 
