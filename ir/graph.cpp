@@ -4,6 +4,7 @@
 #include "ir/semantics.hpp"
 #include "numeric/rational.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -30,9 +31,15 @@ void mix(std::size_t& h, std::uint64_t v) {
     h ^= std::hash<std::uint64_t>{}(v) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
 }
 
+// Equal rationals are equal in lowest terms: their limbs hash alike.
+void mix_integer(std::size_t& h, mpz_srcptr z) {
+    mix(h, static_cast<std::uint64_t>(mpz_sgn(z) + 1));
+    for (std::size_t k = 0; k < mpz_size(z); ++k) mix(h, static_cast<std::uint64_t>(mpz_getlimbn(z, k)));
+}
+
 } // namespace
 
-std::size_t Graph::KeyHash::operator()(const Node& n) const {
+std::uint32_t Graph::key_hash(const Node& n) {
     std::size_t h = static_cast<std::size_t>(n.op);
     for (NodeId a : n.args) mix(h, a);
     mix(h, bits(n.value.lo));
@@ -44,11 +51,18 @@ std::size_t Graph::KeyHash::operator()(const Node& n) const {
     mix(h, static_cast<std::uint64_t>(n.series.end));
     for (NodeId o : n.orbit) mix(h, o);
     mix(h, bits(n.series.escape.radius));
-    if (n.exact) mix(h, std::hash<std::string>{}(n.exact->to_string()));
-    return h;
+    if (n.exact) {
+        mix_integer(h, n.exact->value().get_num_mpz_t());
+        mix_integer(h, n.exact->value().get_den_mpz_t());
+    }
+    // The table takes the low bits: spread the high ones into them.
+    h ^= h >> 33;
+    h *= 0xff51afd7ed558ccdULL;
+    h ^= h >> 33;
+    return static_cast<std::uint32_t>(h);
 }
 
-bool Graph::KeyEq::operator()(const Node& a, const Node& b) const {
+bool Graph::same_key(const Node& a, const Node& b) {
     // Bitwise comparison of doubles, so that -0 and 0 (and NaN payloads) stay distinct constants.
     return a.op == b.op && a.args == b.args && bits(a.value.lo) == bits(b.value.lo) &&
            bits(a.value.hi) == bits(b.value.hi) && bits(a.point) == bits(b.point) && a.imm == b.imm &&
@@ -60,22 +74,42 @@ bool Graph::KeyEq::operator()(const Node& a, const Node& b) const {
            (a.exact == b.exact || (a.exact && b.exact && *a.exact == *b.exact));
 }
 
+void Graph::grow_index() {
+    std::vector<Slot> larger(std::max<std::size_t>(64, 2 * index_.size()));
+    const std::size_t mask = larger.size() - 1;
+    for (const Slot& s : index_) {
+        if (s.id == no_node) continue;
+        std::size_t at = s.hash & mask;
+        while (larger[at].id != no_node) at = (at + 1) & mask;
+        larger[at] = s;
+    }
+    index_ = std::move(larger);
+}
+
 NodeId Graph::intern(const Node& n) {
-    auto it = index_.find(n);
-    if (it != index_.end()) return it->second;
+    if (2 * (size_ + 1) > index_.size()) grow_index();
+    const std::uint32_t hash = key_hash(n);
+    const std::size_t mask = index_.size() - 1;
+    std::size_t at = hash & mask;
+    for (; index_[at].id != no_node; at = (at + 1) & mask)
+        if (index_[at].hash == hash && same_key((*this)[index_[at].id], n)) return index_[at].id;
     Node stored = n;
     stored.index_mask = 0;
     for (NodeId a : n.args)
-        if (a != no_node) stored.index_mask |= nodes_[a].index_mask;
-    for (NodeId a : n.orbit) stored.index_mask |= nodes_[a].index_mask;
+        if (a != no_node) stored.index_mask |= (*this)[a].index_mask;
+    for (NodeId a : n.orbit) stored.index_mask |= (*this)[a].index_mask;
     for (NodeId a : n.point_tail)
-        if (a != no_node) stored.index_mask |= nodes_[a].index_mask;
+        if (a != no_node) stored.index_mask |= (*this)[a].index_mask;
     if (n.op == Op::Index) stored.index_mask = std::uint64_t{1} << n.imm;
     if (n.op == Op::State) stored.index_mask = std::uint64_t{1} << state_level(n.imm);
     if (is_series(n.op)) stored.index_mask &= ~(std::uint64_t{1} << n.series.level);
-    const auto id = static_cast<NodeId>(nodes_.size());
-    nodes_.push_back(stored);
-    index_.emplace(stored, id);
+    if (chunks_.empty() || chunks_.back().size() == chunk_size) {
+        chunks_.emplace_back();
+        if (chunks_.size() > 1) chunks_.back().reserve(chunk_size);
+    }
+    chunks_.back().push_back(std::move(stored));
+    const auto id = static_cast<NodeId>(size_++);
+    index_[at] = {id, hash};
     return id;
 }
 
@@ -111,8 +145,8 @@ namespace {
 constexpr std::size_t max_exact_bits = 4096;
 
 bool small(const num::Rational& r) {
-    return mpz_sizeinbase(r.numerator().get_mpz_t(), 2) <= max_exact_bits &&
-           mpz_sizeinbase(r.denominator().get_mpz_t(), 2) <= max_exact_bits;
+    return mpz_sizeinbase(r.value().get_num_mpz_t(), 2) <= max_exact_bits &&
+           mpz_sizeinbase(r.value().get_den_mpz_t(), 2) <= max_exact_bits;
 }
 
 num::Rational floor_of(const num::Rational& r) {
@@ -194,14 +228,14 @@ NodeId Graph::fold(const Node& n) {
     const num::Rational* exact[3] = {nullptr, nullptr, nullptr};
     bool all_exact = true;
     for (int i = 0; i < k; ++i)
-        all_exact = all_exact && (exact[i] = nodes_[n.args[i]].exact.get()) != nullptr;
+        all_exact = all_exact && (exact[i] = (*this)[n.args[i]].exact.get()) != nullptr;
     if (all_exact)
         if (std::optional<num::Rational> r = fold_exact(n.op, exact, n.imm)) return constant(*r);
     Interval iv[3];
     double pt[3];
     for (int i = 0; i < k; ++i) {
-        iv[i] = nodes_[n.args[i]].value;
-        pt[i] = nodes_[n.args[i]].point;
+        iv[i] = (*this)[n.args[i]].value;
+        pt[i] = (*this)[n.args[i]].point;
     }
     Interval value;
     {
@@ -221,7 +255,7 @@ NodeId Graph::op(Op op, NodeId a, NodeId b, NodeId c, std::int64_t imm) {
     bool all_const = true;
     for (int i = 0; i < 3; ++i) {
         const bool wanted = i < arity(op);
-        if (wanted != (args[i] != no_node) || (wanted && args[i] >= nodes_.size()))
+        if (wanted != (args[i] != no_node) || (wanted && args[i] >= size_))
             throw std::logic_error(std::string("Graph::op: bad arguments for ") + op_name(op));
         n.args[static_cast<std::size_t>(i)] = args[i];
         if (wanted) all_const = all_const && is_const(args[i]);
@@ -237,7 +271,7 @@ NodeId Graph::op(Op op, NodeId a, NodeId b, NodeId c, std::int64_t imm) {
     if (op == Op::Mul && a == b) return this->op(Op::Sqr, a);
     // A select on a decided condition is its branch.
     if (op == Op::Select && is_const(a)) {
-        const Interval cond = nodes_[a].value;
+        const Interval cond = (*this)[a].value;
         if (cond == tv_true) return b;
         if (cond == tv_false) return c;
     }
@@ -274,7 +308,7 @@ NodeId Graph::external(std::int64_t index, NodeId a, NodeId b, NodeId c) {
 }
 
 bool Graph::const_integer(NodeId id, std::int64_t& value) const {
-    const Node& n = nodes_[id];
+    const Node& n = (*this)[id];
     if (n.op != Op::Const || !n.value.is_thin() || std::floor(n.value.lo) != n.value.lo ||
         std::fabs(n.value.lo) > 9.0e15)
         return false;

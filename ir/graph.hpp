@@ -130,8 +130,8 @@ struct Node {
 
 class Graph {
 public:
-    const Node& operator[](NodeId id) const { return nodes_[id]; }
-    std::size_t size() const { return nodes_.size(); }
+    const Node& operator[](NodeId id) const { return chunks_[id >> chunk_bits][id & (chunk_size - 1)]; }
+    std::size_t size() const { return size_; }
 
     NodeId constant(Interval value, double point);
     // A double is a rational: an exact constant when finite.
@@ -139,7 +139,7 @@ public:
     // An exact rational constant; its enclosure is taken here, when it is lowered to the graph.
     NodeId constant(const num::Rational& exact);
     // The exact value of a constant node, or null.
-    const num::Rational* exact_value(NodeId id) const { return nodes_[id].exact.get(); }
+    const num::Rational* exact_value(NodeId id) const { return (*this)[id].exact.get(); }
     NodeId var(int index);
     NodeId index(int level);
     // Component `component` of the orbit point of the series of level `level`.
@@ -153,7 +153,7 @@ public:
     // point passes a constant 0 as c. Never folded, even on constants.
     NodeId external(std::int64_t index, NodeId a, NodeId b, NodeId c);
 
-    bool is_const(NodeId id) const { return nodes_[id].op == Op::Const; }
+    bool is_const(NodeId id) const { return (*this)[id].op == Op::Const; }
 
     // The implementations of the External nodes, by their imm. A slot stays null until a driver binds
     // it (driver/pipeline.cpp); tapes built afterwards carry the bound implementations.
@@ -165,14 +165,23 @@ private:
     NodeId intern(const Node& n);
     NodeId fold(const Node& n);
 
-    struct KeyHash {
-        std::size_t operator()(const Node& n) const;
+    static std::uint32_t key_hash(const Node& n);
+    static bool same_key(const Node& a, const Node& b);
+    void grow_index();
+
+    // The nodes, in chunks of chunk_size (the first grows up to it): a large graph grows without moving
+    // the nodes it has.
+    static constexpr unsigned chunk_bits = 12;
+    static constexpr std::size_t chunk_size = std::size_t{1} << chunk_bits;
+    std::vector<std::vector<Node>> chunks_;
+    std::size_t size_ = 0;
+    // Hash-consing: an open-addressing table (a power of two in size, at most half full) of node ids
+    // (no_node where empty) with their hashes, so that probing and growing read no node but a match.
+    struct Slot {
+        NodeId id = no_node;
+        std::uint32_t hash = 0;
     };
-    struct KeyEq {
-        bool operator()(const Node& a, const Node& b) const;
-    };
-    std::vector<Node> nodes_;
-    std::unordered_map<Node, NodeId, KeyHash, KeyEq> index_;
+    std::vector<Slot> index_;
 };
 
 // Text form of the sub-graph reachable from `roots`, one node a line ("%4 = add %2, %3").
