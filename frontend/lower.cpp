@@ -18,6 +18,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <string_view>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -29,11 +30,45 @@ namespace {
 
 struct Closure;
 
+// The nodes of a value: held inline up to a point's three coordinates, as nearly every value is a
+// number or a point (more, a query's components, go to the heap).
+class NodeList {
+public:
+    NodeList() = default;
+    NodeList(std::initializer_list<NodeId> nodes) {
+        for (NodeId n : nodes) push_back(n);
+    }
+    std::vector<NodeId> vector() const { return {begin(), end()}; }
+
+    void push_back(NodeId n) {
+        if (size_ < inline_.size()) {
+            inline_[size_] = n;
+        } else {
+            if (size_ == inline_.size()) heap_.assign(inline_.begin(), inline_.end());
+            heap_.push_back(n);
+        }
+        ++size_;
+    }
+    std::size_t size() const { return size_; }
+    bool empty() const { return size_ == 0; }
+    NodeId* begin() { return size_ <= inline_.size() ? inline_.data() : heap_.data(); }
+    NodeId* end() { return begin() + size_; }
+    const NodeId* begin() const { return size_ <= inline_.size() ? inline_.data() : heap_.data(); }
+    const NodeId* end() const { return begin() + size_; }
+    NodeId& operator[](std::size_t i) { return begin()[i]; }
+    NodeId operator[](std::size_t i) const { return begin()[i]; }
+
+private:
+    std::size_t size_ = 0;
+    std::array<NodeId, 3> inline_{};
+    std::vector<NodeId> heap_; // all of them, when more than fit inline
+};
+
 // A value during lowering: its graph nodes (or constant box) and, for a function or shape used as a
 // value, which one.
 struct Value {
     ValueKind kind = ValueKind::scalar;
-    std::vector<NodeId> nodes;
+    NodeList nodes;
     std::vector<Interval> box;
     const Item* shape = nullptr; // a shape used as a value (enclose, dimension), or passed as a function
     // A function passed as an argument (resolve_names checked its uses): inlined where it is called.
@@ -123,7 +158,7 @@ public:
         if (q.kind != ValueKind::point || static_cast<int>(q.nodes.size()) != dimension)
             fail(map.body->loc,
                  fmt::format("the map '{}' must return a point of {} coordinates", map.name, dimension));
-        return q.nodes;
+        return q.nodes.vector();
     }
 
     void run() {
@@ -319,7 +354,7 @@ private:
 
     void print(const Item& it) {
         const Value v = closed(*it.body, Context::test);
-        m_.prints.push_back({it.loc, v.kind, v.nodes, v.box});
+        m_.prints.push_back({it.loc, v.kind, v.nodes.vector(), v.box});
     }
 
     // ---- scopes and inlining ----
@@ -413,13 +448,16 @@ private:
     }
 
     Value number(const Expr& e) {
+        if (auto known = literals_.find(e.text); known != literals_.end())
+            return Value::scalar(known->second);
         const Interval v = num::from_decimal(e.text);
         if (!std::isfinite(v.lo) || !std::isfinite(v.hi))
             fail(e.loc, fmt::format("number '{}' is too large", e.text));
         // A literal keeps its exact value as written (0.1 is 1/10), for exact folding and solving.
-        if (const std::optional<num::Rational> exact = num::Rational::parse_decimal(e.text))
-            return Value::scalar(g_.constant(*exact));
-        return Value::scalar(g_.constant(v, std::strtod(e.text.c_str(), nullptr)));
+        const std::optional<num::Rational> exact = num::Rational::parse_decimal(e.text);
+        const NodeId n = exact ? g_.constant(*exact) : g_.constant(v, std::strtod(e.text.c_str(), nullptr));
+        literals_.emplace(e.text, n);
+        return Value::scalar(n);
     }
 
     Value name(const Expr& e) {
@@ -1380,7 +1418,7 @@ private:
                 next = inline_body(map, {{map.params[0].name, state}}, e.orbit_loc, frames_.back().ctx);
             }
             frames_[frame].scopes.back().emplace_back(e.orbit_var, state);
-            orbit = init.nodes;
+            orbit = init.nodes.vector();
             orbit.insert(orbit.end(), next.nodes.begin(), next.nodes.end());
         }
         const NodeId body = scalar(expr(*e.kids[2]), e.kids[2]->loc);
@@ -1419,6 +1457,9 @@ private:
     std::vector<const Item*> external_items_; // the automaton of each of m_.externals
     std::unordered_map<const Item*, std::optional<Value>> consts_;
     std::unordered_set<const Item*> failed_consts_;
+    // The node of each literal's text (the syntax tree outlives the lowering): a model repeats its
+    // literals, each parsed once.
+    std::unordered_map<std::string_view, NodeId> literals_;
 };
 
 } // namespace
