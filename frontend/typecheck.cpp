@@ -757,8 +757,8 @@ void typecheck(const Program& program, const Limits& limits, TypedProgram& out, 
 std::string print_types(const Program& program, const TypedProgram& typed, std::uint32_t file) {
     std::string out;
     const auto type_of = [&](const Expr* e) {
-        auto t = e ? typed.exprs.find(e) : typed.exprs.end();
-        return t == typed.exprs.end() ? std::string("unchecked") : type_spelling(t->second);
+        const Type* t = typed.exprs.find(e);
+        return t ? type_spelling(*t) : std::string("unchecked");
     };
     for (const Item& it : program.items) {
         if (file != 0 && it.loc.file != file) continue;

@@ -6,6 +6,7 @@
 
 #include "frontend/ast.hpp"
 #include "frontend/lower.hpp"
+#include "frontend/pointer_map.hpp"
 #include "frontend/types.hpp"
 
 #include <string>
@@ -26,7 +27,7 @@ struct TypedProgram {
     std::unordered_map<const Item*, Type> items; // const: its value's type; shape: Type{shape, dimension}
     std::vector<FunctionInstance> instances;     // in the order first used
     // The type of each expression; in a function's body, the type under its latest instance.
-    std::unordered_map<const Expr*, Type> exprs;
+    PointerMap<Expr, Type> exprs;
     // The items and expectations (Expect) with a type error, reported: lowering skips them and lowers
     // the rest, so that errors that need values are found in the same run.
     std::unordered_set<const void*> failed;
