@@ -82,6 +82,9 @@ public:
 
     std::vector<Token> run() {
         std::vector<Token> out;
+        // A token takes a character or two at the least: the list never moves while it grows, and the
+        // pages reserved beyond its end are never touched.
+        out.reserve(s_.size() / 2 + 1);
         for (;;) {
             skip_space_and_comments();
             Token t;
