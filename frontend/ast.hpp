@@ -47,17 +47,19 @@ struct Arg {
     ExprPtr value;
 };
 
+// What every pass reads of every node comes first, the fields of series only last: a walk over a large
+// tree touches fewer cache lines.
 struct Expr {
     ExprKind kind;
+    Tok op = Tok::end; // unary / binary operator
     Location loc;
+    std::vector<ExprPtr> kids;
+    std::vector<Arg> args;
+    std::vector<Binding> bindings;
     std::string text;
     std::string var;                  // series index name
     std::string orbit_var, orbit_map; // orbit series: the point's name and the map (a function)
     Location orbit_loc, escape_loc;
-    Tok op = Tok::end; // unary / binary operator
-    std::vector<ExprPtr> kids;
-    std::vector<Arg> args;
-    std::vector<Binding> bindings;
 };
 
 enum class ItemKind { import, fn, const_, shape, test, print, automaton };
