@@ -277,25 +277,35 @@ private:
         return find_builtin(name) != nullptr;
     }
 
+    // A name used as a value: each scope and the globals are looked up once.
+    void name(const Expr& e) {
+        if (is_unknown(e)) {
+            d_.error(e.loc,
+                     "'?' (an unknown) is a whole entry of an operator's matrix, or the whole operator");
+            return;
+        }
+        const std::optional<int> l = local(e.text);
+        const auto g = l ? globals_.end() : globals_.find(e.text);
+        const bool global = g != globals_.end();
+        if (!l && !global) {
+            if (is_builtin_constant(e.text)) return;
+            if (find_builtin(e.text))
+                d_.error(e.loc, fmt::format("'{}' is a function; call it with arguments", e.text));
+            else
+                unknown(e.loc, "name", e.text);
+            return;
+        }
+        const bool function = l ? *l != value : g->second->kind == ItemKind::fn;
+        if (function && !is_builtin_constant(e.text))
+            d_.error(e.loc, fmt::format("'{}' is a function; call it with arguments, or pass it where a "
+                                        "function is expected",
+                                        e.text));
+    }
+
     void expr(const Expr& e) {
         switch (e.kind) {
         case ExprKind::number: return;
-        case ExprKind::name:
-            if (is_unknown(e)) {
-                d_.error(e.loc,
-                         "'?' (an unknown) is a whole entry of an operator's matrix, or the whole operator");
-            } else if (names_function(e.text) && !is_builtin_constant(e.text) &&
-                       (is_local(e.text) || globals_.count(e.text))) {
-                d_.error(e.loc, fmt::format("'{}' is a function; call it with arguments, or pass it where a "
-                                            "function is expected",
-                                            e.text));
-            } else if (!is_local(e.text) && !globals_.count(e.text) && !is_builtin_constant(e.text)) {
-                if (globals_.count(e.text) == 0 && find_builtin(e.text))
-                    d_.error(e.loc, fmt::format("'{}' is a function; call it with arguments", e.text));
-                else
-                    unknown(e.loc, "name", e.text);
-            }
-            return;
+        case ExprKind::name: name(e); return;
         case ExprKind::call: call(e); return;
         case ExprKind::let: {
             scopes_.emplace_back();
