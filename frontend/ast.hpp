@@ -47,8 +47,15 @@ struct Arg {
     ExprPtr value;
 };
 
-// What every pass reads of every node comes first, the fields of series only last: a walk over a large
-// tree touches fewer cache lines.
+// What only a series has, apart from its expression: few nodes are series.
+struct SeriesSyntax {
+    std::string var;                  // the index's name
+    std::string orbit_var, orbit_map; // orbit series: the point's name and the map (a function)
+    Location orbit_loc, escape_loc;
+};
+
+// Small, with what every pass reads of every node first: a large tree takes less memory, and its walks
+// touch fewer cache lines.
 struct Expr {
     ExprKind kind;
     Tok op = Tok::end; // unary / binary operator
@@ -57,9 +64,7 @@ struct Expr {
     std::vector<Arg> args;
     std::vector<Binding> bindings;
     std::string text;
-    std::string var;                  // series index name
-    std::string orbit_var, orbit_map; // orbit series: the point's name and the map (a function)
-    Location orbit_loc, escape_loc;
+    std::unique_ptr<SeriesSyntax> series; // a series's; null for the other kinds
 };
 
 enum class ItemKind { import, fn, const_, shape, test, print, automaton };

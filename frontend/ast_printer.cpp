@@ -99,12 +99,13 @@ std::string print_expr(const Expr& e) {
         return fmt::format("(fn ({}){})", names, kids());
     }
     case ExprKind::series:
-        if (!e.orbit_var.empty())
-            return fmt::format(
-                "({} {} {} {} (orbit {} {} {}{}) {})", e.text, e.var, print_expr(*e.kids[0]),
-                e.kids[1] ? print_expr(*e.kids[1]) : "inf", e.orbit_var, print_expr(*e.kids[3]), e.orbit_map,
-                e.kids.size() > 4 ? " (escape " + print_expr(*e.kids[4]) + ")" : "", print_expr(*e.kids[2]));
-        return fmt::format("({} {}{})", e.text, e.var, kids());
+        if (!e.series->orbit_var.empty())
+            return fmt::format("({} {} {} {} (orbit {} {} {}{}) {})", e.text, e.series->var,
+                               print_expr(*e.kids[0]), e.kids[1] ? print_expr(*e.kids[1]) : "inf",
+                               e.series->orbit_var, print_expr(*e.kids[3]), e.series->orbit_map,
+                               e.kids.size() > 4 ? " (escape " + print_expr(*e.kids[4]) + ")" : "",
+                               print_expr(*e.kids[2]));
+        return fmt::format("({} {}{})", e.text, e.series->var, kids());
     }
     return "?";
 }

@@ -32,11 +32,7 @@ ExprPtr copy(const Expr& e) {
     c->kind = e.kind;
     c->loc = e.loc;
     c->text = e.text;
-    c->var = e.var;
-    c->orbit_var = e.orbit_var;
-    c->orbit_map = e.orbit_map;
-    c->orbit_loc = e.orbit_loc;
-    c->escape_loc = e.escape_loc;
+    if (e.series) c->series = std::make_unique<SeriesSyntax>(*e.series);
     c->op = e.op;
     for (const ExprPtr& k : e.kids) c->kids.push_back(k ? copy(*k) : nullptr);
     for (const Arg& a : e.args) c->args.push_back({a.name, a.loc, a.value ? copy(*a.value) : nullptr});

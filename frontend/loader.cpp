@@ -119,8 +119,9 @@ private:
         case ExprKind::series:
             for (std::size_t k : {0u, 1u, 3u, 4u})
                 if (k < e.kids.size() && e.kids[k]) expr(*e.kids[k]);
-            if (!e.orbit_map.empty() && global(e.orbit_map)) e.orbit_map = qualified(e.orbit_map);
-            locals_.push_back({e.var, e.orbit_var});
+            if (!e.series->orbit_map.empty() && global(e.series->orbit_map))
+                e.series->orbit_map = qualified(e.series->orbit_map);
+            locals_.push_back({e.series->var, e.series->orbit_var});
             expr(*e.kids[2]);
             locals_.pop_back();
             return;

@@ -1325,9 +1325,10 @@ private:
     NodeId escape_radius_of(const Expr& e, bool infinite) {
         const Expr& r = *e.kids[4];
         if (!infinite)
-            fail(e.escape_loc, "an escape certificate needs an infinite series (a finite one has no tail)");
+            fail(e.series->escape_loc,
+                 "an escape certificate needs an infinite series (a finite one has no tail)");
         if (e.text == "sum")
-            fail(e.escape_loc, "an escape certificate applies to min and max series, not to a sum");
+            fail(e.series->escape_loc, "an escape certificate applies to min and max series, not to a sum");
         const NodeId radius = scalar(expr(r), r.loc);
         if (!g_.is_const(radius) || !(g_[radius].value.lo >= 0) || !std::isfinite(g_[radius].value.hi))
             fail(r.loc, "the escape radius must be a finite constant >= 0");
@@ -1342,12 +1343,12 @@ private:
             num::UpwardRounding up;
             escape = prove_orbit_escape(g_, body, map, data.level, kind, g_[radius].value, why);
         }
-        if (!escape) fail(e.escape_loc, "cannot prove this escape certificate: " + why);
+        if (!escape) fail(e.series->escape_loc, "cannot prove this escape certificate: " + why);
         if (!(escape->slope > 0))
             // The bound (s (|q| - r) + d) * scale is then never positive (negative for a max): it proves
             // no cell outside the shape, and covers run every term of the orbit in vain.
             d_.warning(
-                e.escape_loc,
+                e.series->escape_loc,
                 fmt::format("this escape certificate cannot make a term {}: the term is bounded {} on "
                             "the orbit point only by s |q| + d with s = 0; write it so that it grows "
                             "with the norm of the orbit point (for example through sqrt(p.x^2 + p.y^2))",
@@ -1387,7 +1388,7 @@ private:
                                     raised_by("FRAC_MAX_SERIES_NESTING")));
         data.level = ++frames_[frame].level;
         frames_[frame].scopes.emplace_back();
-        frames_[frame].scopes.back().emplace_back(e.var, Value::scalar(g_.index(data.level)));
+        frames_[frame].scopes.back().emplace_back(e.series->var, Value::scalar(g_.index(data.level)));
         struct Restore {
             std::vector<Frame>& frames;
             std::size_t frame;
@@ -1398,26 +1399,27 @@ private:
         } restore{frames_, frame};
         std::vector<NodeId> orbit; // initial point, then the map applied to the state
         NodeId escape_radius = ir::no_node;
-        if (!e.orbit_var.empty()) {
+        if (!e.series->orbit_var.empty()) {
             // The initial point is outside the series (the index is not visible to it).
             frames_[frame].scopes.pop_back();
             const Value init = expr(*e.kids[3]);
             if (e.kids.size() > 4) escape_radius = escape_radius_of(e, infinite);
             frames_[frame].scopes.emplace_back();
-            frames_[frame].scopes.back().emplace_back(e.var, Value::scalar(g_.index(data.level)));
+            frames_[frame].scopes.back().emplace_back(e.series->var, Value::scalar(g_.index(data.level)));
             data.state_count = static_cast<int>(init.nodes.size());
             Value state;
             state.kind = ValueKind::point;
             for (int c = 0; c < data.state_count; ++c) state.nodes.push_back(g_.state(data.level, c));
-            const Value* local_map = lookup_local(e.orbit_map); // a function parameter (type checked)
+            const Value* local_map = lookup_local(e.series->orbit_map); // a function parameter (type checked)
             Value next;
             if (local_map && local_map->closure) {
-                next = call_closure(*local_map->closure, {state}, e.orbit_loc);
+                next = call_closure(*local_map->closure, {state}, e.series->orbit_loc);
             } else {
-                const Item& map = local_map ? *local_map->function : *globals_.at(e.orbit_map);
-                next = inline_body(map, {{map.params[0].name, state}}, e.orbit_loc, frames_.back().ctx);
+                const Item& map = local_map ? *local_map->function : *globals_.at(e.series->orbit_map);
+                next =
+                    inline_body(map, {{map.params[0].name, state}}, e.series->orbit_loc, frames_.back().ctx);
             }
-            frames_[frame].scopes.back().emplace_back(e.orbit_var, state);
+            frames_[frame].scopes.back().emplace_back(e.series->orbit_var, state);
             orbit = init.nodes.vector();
             orbit.insert(orbit.end(), next.nodes.begin(), next.nodes.end());
         }

@@ -622,6 +622,7 @@ private:
         count_operator(loc);
         auto e = make(ExprKind::binary, loc);
         e->op = op;
+        e->kids.reserve(2); // one allocation, not two
         e->kids.push_back(std::move(a));
         e->kids.push_back(std::move(b));
         return e;
@@ -790,7 +791,7 @@ private:
             }
             if (!at(Tok::lparen)) {
                 auto e = make(ExprKind::name, name.loc);
-                e->text = text;
+                e->text = std::move(text);
                 return e;
             }
             take();
@@ -798,7 +799,7 @@ private:
                 ahead(1).kind == Tok::kw_in)
                 return series(name);
             auto e = make(ExprKind::call, name.loc);
-            e->text = text;
+            e->text = std::move(text);
             if (!accept(Tok::rparen)) {
                 do {
                     Arg a;
@@ -879,8 +880,9 @@ private:
     // sum(i in a.., body), min(i in a..b, body), max(...)
     ExprPtr series(const Token& name) {
         auto e = make(ExprKind::series, name.loc);
+        e->series = std::make_unique<SeriesSyntax>();
         e->text = name.text;
-        e->var = take().text;
+        e->series->var = take().text;
         expect(Tok::kw_in, "after the series index");
         e->kids.push_back(add_expr());
         expect(Tok::dotdot, "in the index range");
@@ -889,23 +891,23 @@ private:
         // An orbit: p in orbit(p0, M) walks p_k = M(p_{k-1}) along with the index.
         if (at(Tok::ident) && ahead(1).kind == Tok::kw_in && ahead(2).kind == Tok::ident &&
             ahead(2).text == "orbit" && ahead(3).kind == Tok::lparen) {
-            e->orbit_loc = cur().loc;
-            e->orbit_var = take().text;
+            e->series->orbit_loc = cur().loc;
+            e->series->orbit_var = take().text;
             take();
             take();
             take();
             ExprPtr init = expr();
             expect(Tok::comma, "after the orbit's initial point");
-            e->orbit_map = expect(Tok::ident, "(the map of the orbit)").text;
-            if (aliases_.count(e->orbit_map) && at(Tok::dot) && ahead(1).kind == Tok::ident) {
+            e->series->orbit_map = expect(Tok::ident, "(the map of the orbit)").text;
+            if (aliases_.count(e->series->orbit_map) && at(Tok::dot) && ahead(1).kind == Tok::ident) {
                 take();
-                e->orbit_map += "." + take().text;
+                e->series->orbit_map += "." + take().text;
             }
             expect(Tok::rparen, "to close the orbit");
             // An escape certificate: `escape R`, a radius the compiler proves orbits never return from.
             ExprPtr escape;
             if (at(Tok::ident) && cur().text == "escape") {
-                e->escape_loc = take().loc;
+                e->series->escape_loc = take().loc;
                 escape = add_expr();
             }
             expect(Tok::comma, "after the orbit");

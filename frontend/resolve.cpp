@@ -122,11 +122,11 @@ private:
         case ExprKind::series:
             changed |= infer(*e.kids[0]);
             if (e.kids[1]) changed |= infer(*e.kids[1]);
-            if (!e.orbit_var.empty()) {
+            if (!e.series->orbit_var.empty()) {
                 changed |= infer(*e.kids[3]);
-                changed |= mark_function(e.orbit_map, 1, e.orbit_loc);
+                changed |= mark_function(e.series->orbit_map, 1, e.series->orbit_loc);
             }
-            shadows_.push_back({e.var, e.orbit_var});
+            shadows_.push_back({e.series->var, e.series->orbit_var});
             changed |= infer(*e.kids[2]);
             shadows_.pop_back();
             return changed;
@@ -320,28 +320,28 @@ private:
         case ExprKind::series: {
             expr(*e.kids[0]);
             if (e.kids[1]) expr(*e.kids[1]);
-            if (!e.orbit_var.empty()) {
+            if (!e.series->orbit_var.empty()) {
                 expr(*e.kids[3]);
                 if (e.kids.size() > 4) expr(*e.kids[4]);
-                auto m = globals_.find(e.orbit_map);
-                if (const std::optional<int> l = local(e.orbit_map)) {
+                auto m = globals_.find(e.series->orbit_map);
+                if (const std::optional<int> l = local(e.series->orbit_map)) {
                     if (*l == value)
                         d_.error(
-                            e.orbit_loc,
+                            e.series->orbit_loc,
                             fmt::format("the map of an orbit must be a function of a point, '{}' is a value",
-                                        e.orbit_map));
+                                        e.series->orbit_map));
                 } else if (m == globals_.end() || m->second->kind != ItemKind::fn)
-                    d_.error(e.orbit_loc,
+                    d_.error(e.series->orbit_loc,
                              fmt::format("the map of an orbit must be a function of a point, '{}' is not one",
-                                         e.orbit_map));
+                                         e.series->orbit_map));
                 else if (m->second->params.size() != 1)
-                    d_.error(e.orbit_loc,
+                    d_.error(e.series->orbit_loc,
                              fmt::format("the map of an orbit takes one point; '{}' takes {} arguments",
-                                         e.orbit_map, m->second->params.size()));
+                                         e.series->orbit_map, m->second->params.size()));
             }
             scopes_.emplace_back();
-            scopes_.back()[e.var] = value;
-            if (!e.orbit_var.empty()) scopes_.back()[e.orbit_var] = value;
+            scopes_.back()[e.series->var] = value;
+            if (!e.series->orbit_var.empty()) scopes_.back()[e.series->orbit_var] = value;
             expr(*e.kids[2]);
             scopes_.pop_back();
             return;

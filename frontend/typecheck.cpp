@@ -683,39 +683,39 @@ private:
             std::size_t i;
             ~Pop() { f[i].scopes.pop_back(); }
         } pop{frames_, frame};
-        if (!e.orbit_var.empty()) {
+        if (!e.series->orbit_var.empty()) {
             // The initial point is outside the series (the index is not visible to it).
             const Type init = expr(*e.kids[3]).type;
             if (e.kids.size() > 4) expr(*e.kids[4]);
             if (init.kind != Type::Kind::point)
                 fail(e.kids[3]->loc, fmt::format("an orbit starts at a point, found {}", type_name(init)));
-            scope().emplace_back(e.var, TValue::of(Type::number()));
-            const TValue* local_map = lookup_local(e.orbit_map);
+            scope().emplace_back(e.series->var, TValue::of(Type::number()));
+            const TValue* local_map = lookup_local(e.series->orbit_map);
             if (local_map && !local_map->item && !local_map->closure)
-                fail(e.orbit_loc,
+                fail(e.series->orbit_loc,
                      fmt::format("the map of an orbit must be a function of a point defined with "
                                  "'fn'; '{}' is bound to a builtin or a shape",
-                                 e.orbit_map));
+                                 e.series->orbit_map));
             Type next;
             if (local_map && local_map->closure) {
-                next = call_closure(*local_map->closure, {TValue::of(init)}, e.orbit_loc).type;
+                next = call_closure(*local_map->closure, {TValue::of(init)}, e.series->orbit_loc).type;
             } else {
-                const Item& map = local_map ? *local_map->item : *globals_.at(e.orbit_map);
+                const Item& map = local_map ? *local_map->item : *globals_.at(e.series->orbit_map);
                 if (map.kind != ItemKind::fn)
-                    fail(e.orbit_loc,
+                    fail(e.series->orbit_loc,
                          fmt::format("the map of an orbit must be a function of a point defined with "
                                      "'fn'; '{}' is bound to a builtin or a shape",
-                                     e.orbit_map));
-                next = inline_body(map, {{map.params[0].name, TValue::of(init)}}, e.orbit_loc,
+                                     e.series->orbit_map));
+                next = inline_body(map, {{map.params[0].name, TValue::of(init)}}, e.series->orbit_loc,
                                    frames_.back().ctx)
                            .type;
             }
             if (next != init)
-                fail(e.orbit_loc, fmt::format("the map '{}' must return a point of {} coordinates",
-                                              e.orbit_map, init.size));
-            scope().emplace_back(e.orbit_var, TValue::of(init));
+                fail(e.series->orbit_loc, fmt::format("the map '{}' must return a point of {} coordinates",
+                                                      e.series->orbit_map, init.size));
+            scope().emplace_back(e.series->orbit_var, TValue::of(init));
         } else {
-            scope().emplace_back(e.var, TValue::of(Type::number()));
+            scope().emplace_back(e.series->var, TValue::of(Type::number()));
         }
         require_number(expr(*e.kids[2]).type, e.kids[2]->loc);
         return TValue::of(Type::number());
