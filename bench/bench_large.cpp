@@ -4,6 +4,8 @@
 //    models only: it takes minutes on the big ones), with pruning by default (every cell with
 //    children asks; the engine's rule decides) and with pruning only 5 or 3 or more levels above
 //    the depth (5: the old rule; without the JIT on big models its cover is the reference);
+//  - the tape interpreter (the reference, instruction by instruction) with pruning, which flat tapes
+//    such as these ran on before the flat interpreter;
 //  - the JIT with pruning (its compile time apart and in the wall time); the JIT only up to 1000
 //    clauses (LLVM takes tens of seconds there already).
 // Prints per variant the nanoseconds per evaluation of the cover (wall clock and this thread's CPU
@@ -12,7 +14,8 @@
 // interpreter, the cells, the prune requests, the pruned functions made and the mean instructions
 // per evaluation. Writes the models (for `frac render`) and JSON.
 //
-//   bench_large [depth=10] [json=bench_large.json] [model_dir=.] [sizes=1000,3000,7000] [jit=1]
+//   bench_large [depth=10] [json=bench_large.json] [model_dir=.] [sizes=1000,3000,7000] [jit=1] [quick]
+// `quick`: the default pruned interpreter alone (no reference cover, no comparison): for profiling.
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/jit.hpp"
 #include "bench/bench_common.hpp"
@@ -38,6 +41,7 @@ struct Variant {
     bool jit = false;
     bool prune = true;
     int min_remaining = rt::default_prune_min_remaining;
+    bool tape_interpreter = false; // the instruction-by-instruction interpreter, not the flat one
 };
 
 // CPU time of this thread: the machine is shared, and a cover on one thread is this thread's work.
@@ -58,7 +62,9 @@ Run cover(const ir::Tape& tape, const std::vector<ir::Interval>& box, int depth,
     eo.prune = v.prune;
     Run run;
     const auto t0 = Clock::now();
-    auto e = v.jit ? jit::make_jit(tape, eo) : interp::make_interpreter(tape, eo);
+    auto e = v.jit                ? jit::make_jit(tape, eo)
+             : v.tape_interpreter ? interp::make_tape_interpreter(tape, eo)
+                                  : interp::make_interpreter(tape, eo);
     run.compile_s = seconds_since(t0);
     rt::RssOptions ro;
     ro.depth = depth;
@@ -88,6 +94,7 @@ int main(int argc, char** argv) {
     const std::string model_dir = argc > 3 ? argv[3] : ".";
     const std::vector<int> sizes = parse_sizes(argc > 4 ? argv[4] : "1000,3000,7000");
     const bool with_jit = argc > 5 ? std::atoi(argv[5]) != 0 : true;
+    const bool quick = argc > 6 && std::string(argv[6]) == "quick";
     std::string why;
     if (with_jit && !jit::jit_available(&why)) {
         std::cerr << "bench_large: the JIT is not available: " << why << "\n";
@@ -103,6 +110,8 @@ int main(int argc, char** argv) {
     const Variant pruned{"interp, pruning (default)", false, true};
     const Variant pruned_late{"interp, pruning (>= 5 levels left)", false, true, 5};
     const Variant pruned_3{"interp, pruning (>= 3 levels left)", false, true, 3};
+    Variant pruned_tape{"tape interpreter, pruning (default)", false, true};
+    pruned_tape.tape_interpreter = true;
     std::string json = "[";
     for (int clauses : sizes) {
         const bench::LargeModel model = bench::large_model(clauses);
@@ -127,16 +136,17 @@ int main(int argc, char** argv) {
                    "ns/eval", "cpu ns/ev", "compile s", "cover s", "wall s", "evals", "pruned", "functions",
                    "cover");
         std::vector<Variant> variants;
-        const bool jit_here = with_jit && clauses <= max_jit_clauses;
+        const bool jit_here = with_jit && clauses <= max_jit_clauses && !quick;
         if (jit_here) variants.push_back({"jit, no pruning", true, false});
-        if (clauses <= max_unpruned_interp) variants.push_back(interp_plain);
+        if (clauses <= max_unpruned_interp && !quick) variants.push_back(interp_plain);
         // Without either, the reference is the old rule's cover (tests compare it with the unpruned one).
-        const bool late_is_reference = variants.empty();
+        const bool late_is_reference = variants.empty() && !quick;
         if (late_is_reference) variants.push_back(pruned_late);
         const std::size_t first_pruned = variants.size();
         variants.push_back(pruned);
-        if (!late_is_reference) variants.push_back(pruned_late);
-        variants.push_back(pruned_3);
+        if (!late_is_reference && !quick) variants.push_back(pruned_late);
+        if (!quick) variants.push_back(pruned_3);
+        if (!quick) variants.push_back(pruned_tape);
         if (jit_here) variants.push_back({"jit, pruning", true, true});
         std::vector<Run> runs;
         for (const Variant& v : variants) {
@@ -148,7 +158,9 @@ int main(int argc, char** argv) {
             fmt::print("  {:<36} {:>10.0f} {:>10.0f} {:>10.3f} {:>10.3f} {:>10.3f} {:>9} {:>9} {:>9}  {}\n",
                        v.name, ns, cpu_ns, r.compile_s, r.cover_s, r.compile_s + r.cover_s,
                        r.result.evaluated, r.result.pruned_evaluations, r.result.specializations,
-                       same ? "same" : "DIFFERS");
+                       quick  ? "not compared"
+                       : same ? "same"
+                              : "DIFFERS");
             if (v.prune)
                 fmt::print("  {:<36} requests {}, unpruned {}, too little {}, declined {}, tape pushes {}, "
                            "compiled {} "
@@ -165,12 +177,19 @@ int main(int argc, char** argv) {
                 depth, ns, cpu_ns, r.compile_s, r.cover_s, r.result.evaluated, r.result.pruned_evaluations,
                 r.result.specializations, same);
         }
-        const Run& base = runs[first_pruned - 1];
         const Run& now = runs[first_pruned];
-        fmt::print(
-            "  pruned interpreter (cpu time) against {}: {:.2f}x; against pruning from 5 levels: {:.2f}x\n",
-            variants[first_pruned - 1].name, base.cover_cpu_s / now.cover_cpu_s,
-            runs[late_is_reference ? 0 : first_pruned + 1].cover_cpu_s / now.cover_cpu_s);
+        if (!quick) {
+            const Run& base = runs[first_pruned - 1];
+            fmt::print("  pruned interpreter (cpu time) against {}: {:.2f}x; against pruning from 5 levels: "
+                       "{:.2f}x\n",
+                       variants[first_pruned - 1].name, base.cover_cpu_s / now.cover_cpu_s,
+                       runs[late_is_reference ? 0 : first_pruned + 1].cover_cpu_s / now.cover_cpu_s);
+            for (std::size_t k = 0; k < variants.size(); ++k)
+                if (variants[k].tape_interpreter)
+                    fmt::print(
+                        "  flat interpreter against the tape interpreter (cpu time, both pruning): {:.2f}x\n",
+                        runs[k].cover_cpu_s / now.cover_cpu_s);
+        }
         fmt::print(
             "  per level (pruned interpreter, default):\n  {:>5} {:>9} {:>9} {:>9} {:>9} {:>12} {:>12}\n",
             "level", "evals", "undecided", "requests", "pruned", "instr/eval", "no pruning");

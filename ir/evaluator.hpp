@@ -80,12 +80,16 @@ public:
     // `box` (shared and cached: clone it for another thread). Null when nothing is pruned, when it
     // would not pay, or when the engine does not specialise.
     virtual std::shared_ptr<Evaluator> specialize(const Interval* box, double expected_evaluations);
-    // specialize(), when this evaluator's last evaluation was eval_box(box): an engine that keeps the
-    // values of that evaluation records the choices from them instead of evaluating again.
-    virtual std::shared_ptr<Evaluator> specialize_after_eval(const Interval* box,
+    // specialize() for box k of this evaluator's last evaluation (eval_box: k = 0; eval_boxes: box k
+    // of its batch): an engine that keeps the values of its last kept_evaluations() boxes records
+    // the choices from them instead of evaluating again.
+    virtual std::shared_ptr<Evaluator> specialize_after_eval(std::size_t k, const Interval* box,
                                                              double expected_evaluations) {
         return specialize(box, expected_evaluations);
     }
+    // How many boxes of its last evaluation (the first ones of a batch) an evaluator keeps the values
+    // of for specialize_after_eval: a caller that prunes evaluates in batches of this size.
+    virtual std::size_t kept_evaluations() const { return 0; }
     // False when specialize() returns null whatever it is asked (nothing to prune, pruning off, an
     // engine that does not specialise): callers skip asking per cell.
     virtual bool may_specialize() const { return false; }

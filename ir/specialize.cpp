@@ -58,20 +58,19 @@ private:
         f_[s] = {v.is_empty(), !v.is_empty() && v.lo >= 0, !v.is_empty() && v.lo > 0};
     }
 
-    // Whether `op` is defined on every sub-box, from what is known of its operands.
+    // Whether `op` is defined on every sub-box, from what is known of its operands: their recorded
+    // enclosures in block 0, the facts of their operations per series term.
     bool defined(const Instr& ins, bool known) const {
-        const auto known_value = [&](int i, auto pred) {
-            return known && pred(v_[ins.in[static_cast<std::size_t>(i)]]);
-        };
+        if (known)
+            return defined_over_box(ins.op, v_[ins.in[0]], arity(ins.op) > 1 ? v_[ins.in[1]] : Interval(),
+                                    ins.imm);
         const SlotFacts& a = f_[ins.in[0]];
         switch (ins.op) {
-        case Op::Div:
-            return f_[ins.in[1]].positive || known_value(1, [](Interval v) { return !contains_zero(v); });
-        case Op::Sqrt: return a.nonneg || known_value(0, [](Interval v) { return v.lo >= 0; });
-        case Op::Log: return a.positive || known_value(0, [](Interval v) { return v.lo > 0; });
-        case Op::Pow: return a.positive || known_value(0, [](Interval v) { return v.lo > 0; });
-        case Op::PowI:
-            return ins.imm >= 0 || a.positive || known_value(0, [](Interval v) { return !contains_zero(v); });
+        case Op::Div: return f_[ins.in[1]].positive;
+        case Op::Sqrt: return a.nonneg;
+        case Op::Log:
+        case Op::Pow: return a.positive;
+        case Op::PowI: return ins.imm >= 0 || a.positive;
         default: return true;
         }
     }
@@ -154,6 +153,50 @@ bool usable(Interval v) {
 
 } // namespace
 
+bool defined_over_box(Op op, Interval a, Interval b, std::int64_t imm) {
+    switch (op) {
+    case Op::Div: return !contains_zero(b);
+    case Op::Sqrt: return a.lo >= 0;
+    case Op::Log:
+    case Op::Pow: return a.lo > 0;
+    case Op::PowI: return imm >= 0 || !contains_zero(a);
+    default: return true;
+    }
+}
+
+Choice decide_choice(Op op, Interval a, Interval b, bool a_may_empty, bool b_may_empty) {
+    if (!usable(a) || !usable(b)) return Choice::both;
+    // The dropped operand must not become empty below (it would empty the result).
+    const bool keep_a = !b_may_empty, keep_b = !a_may_empty;
+    // Min and max need disjoint operands: where they touch, the result's bounds could be a 0 of
+    // the other operand's sign. On truth values (exactly 0 or 1) and is min and or is max, and
+    // false decides an and, true an or, whatever the other operand.
+    switch (op) {
+    case Op::Min:
+        if (b.hi < a.lo && keep_b) return Choice::second;
+        if (a.hi < b.lo && keep_a) return Choice::first;
+        return Choice::both;
+    case Op::And:
+        if (a.hi <= b.lo && keep_a) return Choice::first;
+        if (b.hi <= a.lo && keep_b) return Choice::second;
+        return Choice::both;
+    case Op::Max:
+        if (b.lo > a.hi && keep_b) return Choice::second;
+        if (a.lo > b.hi && keep_a) return Choice::first;
+        return Choice::both;
+    case Op::Or:
+        if (a.lo >= b.hi && keep_a) return Choice::first;
+        if (b.lo >= a.hi && keep_b) return Choice::second;
+        return Choice::both;
+    case Op::Select: // a is the condition
+        if (a_may_empty) return Choice::both;
+        if (a == tv_true) return Choice::first;
+        if (a == tv_false) return Choice::second;
+        return Choice::both;
+    default: return Choice::both;
+    }
+}
+
 std::vector<Choice> record_choices(const Tape& tape, const Interval* slots) {
     const std::vector<Instr>& main = tape.blocks.at(0);
     std::vector<Choice> choices(main.size(), Choice::both);
@@ -162,41 +205,8 @@ std::vector<Choice> record_choices(const Tape& tape, const Interval* slots) {
     for (std::size_t k = 0; k < main.size(); ++k) {
         const Instr& ins = main[k];
         if (!is_choice(ins.op)) continue;
-        const Interval a = slots[ins.in[0]], b = slots[ins.in[1]];
-        if (!usable(a) || !usable(b)) continue;
-        // The dropped operand must not become empty below (it would empty the result).
-        const bool keep_a = !facts.may_empty(ins.in[1]), keep_b = !facts.may_empty(ins.in[0]);
-        // Min and max need disjoint operands: where they touch, the result's bounds could be a 0 of
-        // the other operand's sign. On truth values (exactly 0 or 1) and is min and or is max, and
-        // false decides an and, true an or, whatever the other operand.
-        switch (ins.op) {
-        case Op::Min:
-            if (a.hi < b.lo && keep_a) choices[k] = Choice::first;
-            if (b.hi < a.lo && keep_b) choices[k] = Choice::second;
-            break;
-        case Op::And:
-            if (a.hi <= b.lo && keep_a)
-                choices[k] = Choice::first;
-            else if (b.hi <= a.lo && keep_b)
-                choices[k] = Choice::second;
-            break;
-        case Op::Max:
-            if (a.lo > b.hi && keep_a) choices[k] = Choice::first;
-            if (b.lo > a.hi && keep_b) choices[k] = Choice::second;
-            break;
-        case Op::Or:
-            if (a.lo >= b.hi && keep_a)
-                choices[k] = Choice::first;
-            else if (b.lo >= a.hi && keep_b)
-                choices[k] = Choice::second;
-            break;
-        case Op::Select:
-            if (facts.may_empty(ins.in[0])) break;
-            if (a == tv_true) choices[k] = Choice::first;
-            if (a == tv_false) choices[k] = Choice::second;
-            break;
-        default: break;
-        }
+        choices[k] = decide_choice(ins.op, slots[ins.in[0]], slots[ins.in[1]], facts.may_empty(ins.in[0]),
+                                   facts.may_empty(ins.in[1]));
     }
     return choices;
 }

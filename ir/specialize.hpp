@@ -38,6 +38,15 @@ bool is_choice(Op op);
 // Whether block 0 of the tape has a choice instruction (else nothing can ever be pruned).
 bool has_choices(const Tape& tape);
 
+// Whether operation `op` (arguments a, b; imm its immediate) is defined on every sub-box of a box
+// over which its arguments have these enclosures (partial operations: div, sqrt, log, pow, powi).
+bool defined_over_box(Op op, Interval a, Interval b, std::int64_t imm);
+
+// The choice a min/max/and/or/select makes over a box where its operands (select: the condition
+// and the then-value) have the enclosures a and b; `x_may_empty`: that operand's enclosure can be
+// empty on a sub-box (it is then never dropped, nor a select decided by it).
+Choice decide_choice(Op op, Interval a, Interval b, bool a_may_empty, bool b_may_empty);
+
 // The choices of the block-0 instructions (one entry per instruction of tape.blocks[0], `both` for
 // any other) after an interval evaluation of `tape` over a box; `slots` is the evaluator's register
 // file (indexed by slot) after that evaluation, so it holds every block-0 value for the box.

@@ -6,6 +6,8 @@
 // optimiser, so it cannot turn -((-x) - y) back into x + y.
 #include "numeric/interval.hpp"
 
+#include "numeric/interval_kernels.hpp"
+
 #include "numeric/llvm_libc.hpp"
 
 #include <algorithm>
@@ -18,60 +20,20 @@
 namespace frac::num {
 namespace {
 
-// Pins a value in a register the optimiser knows nothing about; emits no instruction.
-inline double opaque(double x) {
-#if defined(__x86_64__)
-    asm("" : "+x"(x));
-#elif defined(__aarch64__)
-    asm("" : "+w"(x));
-#else
-    asm("" : "+g"(x));
-#endif
-    return x;
-}
-
 // Keeps memory accesses and calls from moving across a rounding-mode change.
 inline void barrier() {
     asm volatile("" ::: "memory");
 }
 
-// Neighbouring doubles, exact in any rounding mode (glibc's nextafter is much slower).
-double next_up(double x) {
-    if (std::isnan(x) || x == inf) return x;
-    if (x == 0) return std::numeric_limits<double>::denorm_min();
-    const auto bits = std::bit_cast<std::uint64_t>(x);
-    return std::bit_cast<double>(x > 0 ? bits + 1 : bits - 1);
-}
-double next_down(double x) {
-    return -next_up(-x);
-}
-
-// Bounds that came out NaN (inf - inf on degenerate [inf, inf] operands) widen to infinity.
-Interval widen_nan(double lo, double hi) {
-    return {std::isnan(lo) ? -inf : lo, std::isnan(hi) ? inf : hi};
-}
-
-// Rounded-down operations via RD(f) = -RU(-f); valid only under upward rounding.
-double add_down(double x, double y) {
-    return -opaque(opaque(-x) - y);
-}
-double sub_down(double x, double y) {
-    return -opaque(opaque(-x) + y);
-}
-double mul_down(double x, double y) {
-    return -opaque(opaque(-x) * y);
-}
-double div_down(double x, double y) {
-    return -opaque(opaque(-x) / y);
-}
-
-// Products in which a zero factor beats an infinite one (0 * inf = 0, IEEE 1788).
-double mul_up0(double x, double y) {
-    return x == 0 || y == 0 ? 0.0 : x * y;
-}
-double mul_down0(double x, double y) {
-    return x == 0 || y == 0 ? 0.0 : mul_down(x, y);
-}
+using kernels::add_down;
+using kernels::div_down;
+using kernels::mul_down;
+using kernels::mul_down0;
+using kernels::mul_up0;
+using kernels::next_down;
+using kernels::next_up;
+using kernels::sub_down;
+using kernels::widen_nan;
 
 constexpr double pi_lo = 0x1.921fb54442d18p+1; // RN(pi) < pi
 constexpr double pi_hi = 0x1.921fb54442d19p+1;
@@ -196,21 +158,15 @@ Interval intersect(Interval a, Interval b) {
 }
 
 Interval add(Interval a, Interval b) {
-    if (a.is_empty() || b.is_empty()) return Interval::empty();
-    return widen_nan(add_down(a.lo, b.lo), a.hi + b.hi);
+    return kernels::add(a, b);
 }
 
 Interval sub(Interval a, Interval b) {
-    if (a.is_empty() || b.is_empty()) return Interval::empty();
-    return widen_nan(sub_down(a.lo, b.hi), a.hi - b.lo);
+    return kernels::sub(a, b);
 }
 
 Interval mul(Interval a, Interval b) {
-    if (a.is_empty() || b.is_empty()) return Interval::empty();
-    // The product is bilinear, so its extremes are at the corners.
-    return {std::min(
-                {mul_down0(a.lo, b.lo), mul_down0(a.lo, b.hi), mul_down0(a.hi, b.lo), mul_down0(a.hi, b.hi)}),
-            std::max({mul_up0(a.lo, b.lo), mul_up0(a.lo, b.hi), mul_up0(a.hi, b.lo), mul_up0(a.hi, b.hi)})};
+    return kernels::mul(a, b);
 }
 
 Interval div(Interval a, Interval b) {
@@ -234,11 +190,11 @@ Interval div(Interval a, Interval b) {
 }
 
 Interval neg(Interval a) {
-    return {-a.hi, -a.lo};
+    return kernels::neg(a);
 }
 
 Interval sqr(Interval a) {
-    return a.is_empty() ? a : pow_positive(a, 2);
+    return kernels::sqr(a);
 }
 
 Interval powi(Interval a, std::int64_t n) {
@@ -264,27 +220,19 @@ Interval pow(Interval a, Interval b) {
 }
 
 Interval sqrt(Interval a) {
-    if (a.is_empty() || a.hi < 0) return Interval::empty();
-    const double lo = std::max(a.lo, 0.0);
-    const double r = std::sqrt(lo); // RU(sqrt(lo))
-    // r * r - lo is exact in the fma, so its sign says whether r overshoots.
-    return {std::fma(r, r, -lo) > 0 ? next_down(r) : r, std::sqrt(a.hi)};
+    return kernels::sqrt(a);
 }
 
 Interval abs(Interval a) {
-    if (a.is_empty() || a.lo >= 0) return a;
-    if (a.hi <= 0) return neg(a);
-    return {0.0, std::max(-a.lo, a.hi)};
+    return kernels::abs(a);
 }
 
 Interval min(Interval a, Interval b) {
-    if (a.is_empty() || b.is_empty()) return Interval::empty();
-    return {std::min(a.lo, b.lo), std::min(a.hi, b.hi)};
+    return kernels::min(a, b);
 }
 
 Interval max(Interval a, Interval b) {
-    if (a.is_empty() || b.is_empty()) return Interval::empty();
-    return {std::max(a.lo, b.lo), std::max(a.hi, b.hi)};
+    return kernels::max(a, b);
 }
 
 Interval floor(Interval a) {

@@ -80,6 +80,15 @@ inline Interval sub(Interval a, Interval b) {
 
 inline Interval mul(Interval a, Interval b) {
     if (a.is_empty() || b.is_empty()) return Interval::empty();
+    if (a.lo == a.hi || b.lo == b.hi) {
+        // A thin factor (a constant): the four corners below are two equal pairs, and the first of the
+        // smallest (largest) is the one at y.lo unless the one at y.hi is strictly smaller (larger).
+        const double x = b.lo == b.hi ? b.lo : a.lo;
+        const Interval y = b.lo == b.hi ? a : b;
+        const double p = mul_down0(y.lo, x), q = mul_down0(y.hi, x);
+        const double P = mul_up0(y.lo, x), Q = mul_up0(y.hi, x);
+        return {q < p ? q : p, P < Q ? Q : P};
+    }
     // The product is bilinear, so its extremes are at the corners.
     return {std::min(
                 {mul_down0(a.lo, b.lo), mul_down0(a.lo, b.hi), mul_down0(a.hi, b.lo), mul_down0(a.hi, b.hi)}),
@@ -92,14 +101,14 @@ inline Interval neg(Interval a) {
 
 inline Interval abs(Interval a) {
     if (a.is_empty() || a.lo >= 0) return a;
-    if (a.hi <= 0) return neg(a);
+    if (a.hi <= 0) return kernels::neg(a);
     return {0.0, std::max(-a.lo, a.hi)};
 }
 
 // [RD(m.lo^2), RU(m.hi^2)] for m = |a|: the bounds of powi(a, 2), one product each.
 inline Interval sqr(Interval a) {
     if (a.is_empty()) return a;
-    const Interval m = abs(a);
+    const Interval m = kernels::abs(a);
     return {mul_down(m.lo, m.lo), m.hi * m.hi};
 }
 

@@ -505,10 +505,10 @@ private:
         }
     }
 
-    // Evaluates n boxes of one variant into out. A variant that prunes in the chunks evaluates them one
-    // by one, and an undecided cell asks for its pruned function from the values its evaluation left
-    // (Evaluator::specialize_after_eval: no second evaluation). Cell k of the run is cell
-    // index[k] (or first + k) of the batch.
+    // Evaluates n boxes of one variant into out. A variant that prunes in the chunks evaluates them in
+    // batches of the boxes whose values it keeps, and an undecided cell asks for its pruned function
+    // from the values its evaluation left (Evaluator::specialize_after_eval: no second evaluation).
+    // Cell k of the run is cell index[k] (or first + k) of the batch.
     void evaluate_run(const LevelVariant& v, std::size_t worker, const Interval* boxes, std::size_t n,
                       Interval* out, Batch& b, const std::uint32_t* index, std::size_t first) const {
         ir::Evaluator& e = *v.workers[worker];
@@ -517,11 +517,14 @@ private:
             return;
         }
         const auto d = static_cast<std::size_t>(d_);
-        for (std::size_t k = 0; k < n; ++k) {
-            out[k] = e.eval_box(boxes + k * d);
-            if (classify(out[k], r_.options.closed_inside) == Verdict::undecided)
-                b.pruned[index ? index[k] : first + k] =
-                    e.specialize_after_eval(boxes + k * d, expected_descendants_);
+        const std::size_t group = std::max<std::size_t>(e.kept_evaluations(), 1);
+        for (std::size_t k = 0; k < n; k += group) {
+            const std::size_t m = std::min(group, n - k);
+            e.eval_boxes(boxes + k * d, m, out + k);
+            for (std::size_t j = 0; j < m; ++j)
+                if (classify(out[k + j], r_.options.closed_inside) == Verdict::undecided)
+                    b.pruned[index ? index[k + j] : first + k + j] =
+                        e.specialize_after_eval(j, boxes + (k + j) * d, expected_descendants_);
         }
     }
 

@@ -3,12 +3,14 @@
 #include "backend/interp/interpreter.hpp"
 #include "ir/semantics.hpp"
 #include "ir/specialize.hpp"
+#include "numeric/interval_kernels.hpp"
 
 #include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <stdexcept>
 
 namespace frac::interp {
@@ -19,86 +21,168 @@ using ir::Slot;
 
 namespace {
 
+// The operations run_box has a handler of its own for (the others go through ir::apply_interval).
+enum class Handler : std::uint8_t { add, sub, mul, neg, sqr, sqrt, abs, min, max, powi, other };
+
+Handler handler_of(Op op) {
+    switch (op) {
+    case Op::Add: return Handler::add;
+    case Op::Sub: return Handler::sub;
+    case Op::Mul: return Handler::mul;
+    case Op::Neg: return Handler::neg;
+    case Op::Sqr: return Handler::sqr;
+    case Op::Sqrt: return Handler::sqrt;
+    case Op::Abs: return Handler::abs;
+    case Op::Min: return Handler::min;
+    case Op::Max: return Handler::max;
+    case Op::PowI: return Handler::powi;
+    default: return Handler::other;
+    }
+}
+
+// Names of tapes and evaluators, unique in the process.
+std::uint64_t next_id() {
+    static std::atomic<std::uint64_t> counter{0};
+    return ++counter;
+}
+
 struct FlatInstr {
     Slot out;
     std::array<Slot, 3> in; // operands; powi: in[1] holds the exponent
     Op op;
+    Handler handler;
 };
 
-// What every tape pushed from one root shares: the slot numbering, constants and inputs.
-struct FlatRoot {
-    std::uint64_t id; // unique per root in the process: names the constants a register file holds
-    int inputs;
-    Slot num_slots;
-    std::vector<ir::TapeConst> constants;
-    std::vector<Slot> input_slots;
-};
-
-struct FlatCode {
-    std::shared_ptr<const FlatRoot> root;
-    std::vector<FlatInstr> code;
-    Slot result = ir::no_slot;
-    std::vector<std::uint32_t> partial; // instructions that may be undefined (div, sqrt, log, pow, powi)
-    bool has_choices = false;
-};
-
-std::uint64_t next_id() {
-    static std::atomic<std::uint64_t> counter{0};
-    return ++counter;
+FlatInstr flat_instr(Op op, Slot out, std::array<Slot, 3> in) {
+    return {out, in, op, handler_of(op)};
 }
 
 bool is_partial(Op op) {
     return op == Op::Div || op == Op::Sqrt || op == Op::Log || op == Op::Pow || op == Op::PowI;
 }
 
+// A flat tape in dense slots: its constants (slots 0 .. constants.size() - 1), then input k at
+// first_input() + k, then the instructions' results in program order, so the registers of a pushed
+// tape are a few cache lines. One allocation holds its arrays.
+struct FlatCode {
+    std::uint64_t id = 0; // unique in the process: names the constants a register file holds
+    int inputs = 0;
+    Slot num_slots = 0;
+    Slot result = ir::no_slot;
+    bool has_choices = false;
+    std::span<Interval> constants;
+    std::span<double> constant_points;
+    std::span<FlatInstr> code;
+    std::span<std::uint32_t> partial; // instructions that may be undefined (div, sqrt, log, pow, powi)
+
+    Slot constant_count() const { return static_cast<Slot>(constants.size()); }
+    Slot first_input() const { return constant_count(); }
+    Slot first_result() const { return constant_count() + static_cast<Slot>(inputs); }
+
+    static std::shared_ptr<FlatCode> make(int inputs, std::size_t constants, std::size_t instructions,
+                                          std::size_t partial) {
+        auto c = std::make_shared<FlatCode>();
+        c->id = next_id();
+        c->inputs = inputs;
+        c->num_slots = static_cast<Slot>(constants + static_cast<std::size_t>(inputs) + instructions);
+        // Widest alignment first: intervals and doubles, then instructions and indices (4 bytes).
+        const std::size_t bytes = constants * (sizeof(Interval) + sizeof(double)) +
+                                  instructions * sizeof(FlatInstr) + partial * sizeof(std::uint32_t);
+        c->storage_ = std::make_unique<std::byte[]>(bytes);
+        std::byte* p = c->storage_.get();
+        const auto take = [&p]<class T>(std::size_t n, T*) {
+            std::span<T> s(reinterpret_cast<T*>(p), n);
+            p += n * sizeof(T);
+            return s;
+        };
+        c->constants = take(constants, static_cast<Interval*>(nullptr));
+        c->constant_points = take(constants, static_cast<double*>(nullptr));
+        c->code = take(instructions, static_cast<FlatInstr*>(nullptr));
+        c->partial = take(partial, static_cast<std::uint32_t*>(nullptr));
+        return c;
+    }
+
+private:
+    std::unique_ptr<std::byte[]> storage_;
+};
+
 std::int64_t immediate(const FlatInstr& ins) {
     return ins.op == Op::PowI ? static_cast<std::int32_t>(ins.in[1]) : 0;
 }
 
-// A thread's registers and push scratch, shared by every flat evaluator that runs on the thread (one
-// register file per root is enough: pushed tapes keep their root's slots).
+// Names of slots in a tape push (push): a result's number, or a tagged constant or input index.
+inline constexpr std::uint32_t constant_tag = 1u << 31, input_tag = 1u << 30, no_alias = ~0u;
+
+// Boxes one evaluation runs side by side: each instruction is dispatched once for all of them, and
+// their operations are independent (a cover's sibling cells share their parent's tape).
+inline constexpr std::size_t lanes = 4;
+
+// A register file: slot s of lane j at values[s * stride + j]; `code` names the tape whose constants
+// it holds.
+struct RegisterFile {
+    std::uint64_t code = 0;
+    std::vector<Interval> values;
+
+    Interval* of(const FlatCode& c, std::size_t stride) {
+        if (code != c.id) {
+            if (values.size() < c.num_slots * stride) values.resize(c.num_slots * stride);
+            for (std::size_t s = 0; s < c.constants.size(); ++s)
+                std::fill_n(values.begin() + static_cast<std::ptrdiff_t>(s * stride), stride, c.constants[s]);
+            code = c.id;
+        }
+        return values.data();
+    }
+};
+
+// The values of one box of the last evaluation: its lane of a register file.
+struct BoxValues {
+    const Interval* base;
+    std::size_t stride, lane;
+    Interval operator[](Slot s) const { return base[s * stride + lane]; }
+};
+
+// A thread's registers and push scratch, shared by every flat evaluator that runs on the thread.
 struct ThreadFile {
-    std::uint64_t box_root = 0, point_root = 0; // the roots whose constants the files hold
-    std::vector<Interval> boxes;
+    RegisterFile single, side_by_side; // one box; `lanes` boxes
+    std::uint64_t point_code = 0;      // the tape whose constants `points` holds
     std::vector<double> points;
-    std::uint64_t last_eval = 0; // the evaluator whose last eval_box values `boxes` holds
-    // Push scratch: liveness by generation, slot aliases (the identity between pushes), emptiness
-    // flags by slot (zero on constants: cleared per root), the choice taken per instruction.
+    // The last box evaluation: the evaluator, its register file and how many boxes it ran.
+    std::uint64_t last_eval = 0;
+    const RegisterFile* last_file = nullptr;
+    std::size_t last_first = 0, last_count = 0; // the boxes first .. first + count - 1 of its batch
+    // Push scratch (backend/interp/flat_interpreter.cpp, push): by parent slot, the generation that
+    // reached it and its name in the pruned tape; by name, its alias and final slot; the pruned
+    // code in reverse, the parent slots of its constants; emptiness flags by slot.
     std::vector<std::uint32_t> live;
     std::uint32_t generation = 0;
-    std::vector<Slot> remap;
+    std::vector<std::uint32_t> name;
+    std::vector<std::uint32_t> alias, final_slot;
+    std::vector<FlatInstr> reversed;
+    std::vector<Slot> constants;
     std::vector<std::uint8_t> may_empty;
-    std::vector<std::uint8_t> pick;
-    std::vector<Slot> aliased;
 
-    Interval* boxes_of(const FlatRoot& root) {
-        if (box_root != root.id) {
-            if (boxes.size() < root.num_slots) boxes.resize(root.num_slots);
-            for (const ir::TapeConst& c : root.constants) boxes[c.slot] = c.value;
-            box_root = root.id;
-            last_eval = 0;
-            may_empty.assign(root.num_slots, 0);
-        }
-        return boxes.data();
-    }
-    double* points_of(const FlatRoot& root) {
-        if (point_root != root.id) {
-            if (points.size() < root.num_slots) points.resize(root.num_slots);
-            for (const ir::TapeConst& c : root.constants) points[c.slot] = c.point;
-            point_root = root.id;
+    double* points_of(const FlatCode& c) {
+        if (point_code != c.id) {
+            if (points.size() < c.num_slots) points.resize(c.num_slots);
+            std::copy(c.constant_points.begin(), c.constant_points.end(), points.begin());
+            point_code = c.id;
         }
         return points.data();
     }
-    std::uint32_t next_generation(Slot num_slots) {
-        if (live.size() < num_slots) live.resize(num_slots, 0);
+    // Sizes the push scratch for pushes from c.
+    void prepare_push(const FlatCode& c) {
+        if (live.size() < c.num_slots) {
+            live.resize(c.num_slots, 0);
+            name.resize(c.num_slots);
+            alias.resize(c.num_slots);
+            final_slot.resize(c.num_slots);
+            may_empty.resize(c.num_slots);
+        }
+    }
+    std::uint32_t next_generation() {
         if (++generation == 0) { // wrapped: forget every mark
             std::fill(live.begin(), live.end(), 0);
             generation = 1;
-        }
-        if (remap.size() < num_slots) {
-            const std::size_t from = remap.size();
-            remap.resize(num_slots);
-            for (std::size_t s = from; s < num_slots; ++s) remap[s] = static_cast<Slot>(s);
         }
         return generation;
     }
@@ -118,7 +202,7 @@ public:
     FlatInterpreter(std::shared_ptr<const FlatCode> code, const ir::EvalOptions& options)
         : code_(std::move(code)), options_(options), id_(next_id()) {}
 
-    int dimension() const override { return code_->root->inputs; }
+    int dimension() const override { return code_->inputs; }
     std::string engine() const override { return "interp"; }
     std::unique_ptr<ir::Evaluator> clone() const override {
         return std::make_unique<FlatInterpreter>(code_, options_);
@@ -127,7 +211,7 @@ public:
 
     double eval_point(const double* coords) override {
         ++stats.calls;
-        double* r = thread_file().points_of(*code_->root);
+        double* r = thread_file().points_of(*code_);
         load(r, coords);
         for (const FlatInstr& ins : code_->code) {
             double args[3];
@@ -139,65 +223,114 @@ public:
 
     Interval eval_box(const Interval* box) override {
         num::UpwardRounding up;
-        return run_box(box);
+        Interval out;
+        run<1>(box, 1, &out);
+        return out;
     }
 
     void eval_boxes(const Interval* boxes, std::size_t n, Interval* out) override {
         num::UpwardRounding up; // once per batch
-        const auto d = static_cast<std::size_t>(code_->root->inputs);
-        for (std::size_t i = 0; i < n; ++i) out[i] = run_box(boxes + i * d);
+        const auto d = static_cast<std::size_t>(code_->inputs);
+        std::size_t k = 0;
+        for (; k < n; k += lanes) {
+            if (n - k == 1)
+                run<1>(boxes + k * d, 1, out + k);
+            else
+                run<lanes>(boxes + k * d, std::min(lanes, n - k), out + k);
+            thread_file().last_first = k;
+        }
     }
 
     bool may_specialize() const override { return options_.prune && code_->has_choices; }
     bool specializes_independently() const override { return true; } // a tape push, no cache
+    std::size_t kept_evaluations() const override { return lanes; }
     std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
-        return push(box, expected_evaluations, false);
+        return push(box, std::numeric_limits<std::size_t>::max(), expected_evaluations);
     }
-    std::shared_ptr<ir::Evaluator> specialize_after_eval(const Interval* box,
+    std::shared_ptr<ir::Evaluator> specialize_after_eval(std::size_t k, const Interval* box,
                                                          double expected_evaluations) override {
-        return push(box, expected_evaluations, true);
+        return push(box, k, expected_evaluations);
     }
 
 private:
+    // Evaluates n <= L boxes side by side (upward rounding set) into out. Lanes past n repeat box 0.
+    template <std::size_t L>
+    void run(const Interval* boxes, std::size_t n, Interval* out) {
+        stats.calls += n;
+        ThreadFile& file = thread_file();
+        RegisterFile& regs = L == 1 ? file.single : file.side_by_side;
+        Interval* const r = regs.of(*code_, L);
+        const auto d = static_cast<std::size_t>(code_->inputs);
+        Interval* const in = r + code_->first_input() * L;
+        for (std::size_t k = 0; k < d; ++k)
+            for (std::size_t j = 0; j < L; ++j) in[k * L + j] = boxes[(j < n ? j : 0) * d + k];
+        // Threaded dispatch (a computed goto per handler): each handler's jump has its own
+        // prediction history, which a single switch lacks.
+        static constexpr void* handlers[] = {&&add, &&sub, &&mul, &&neg,  &&sqr,  &&sqrt,
+                                             &&abs, &&min, &&max, &&powi, &&other};
+        static_assert(std::size(handlers) == static_cast<std::size_t>(Handler::other) + 1);
+        const FlatInstr* ins = code_->code.data();
+        const FlatInstr* const end = ins + code_->code.size();
+        // Operands are read before the result is written: a result's slot is never an operand's.
+#define FRAC_A r[ins->in[0] * L + j]
+#define FRAC_B r[ins->in[1] * L + j]
+#define FRAC_LANES(expression)                                                                               \
+    {                                                                                                        \
+        Interval t[L];                                                                                       \
+        for (std::size_t j = 0; j < L; ++j) t[j] = expression;                                               \
+        std::copy_n(t, L, r + ins->out * L);                                                                 \
+    }                                                                                                        \
+    if (++ins == end) goto done;                                                                             \
+    goto* handlers[static_cast<std::size_t>(ins->handler)]
+        if (ins == end) goto done;
+        goto* handlers[static_cast<std::size_t>(ins->handler)];
+    add:
+        FRAC_LANES(num::kernels::add(FRAC_A, FRAC_B));
+    sub:
+        FRAC_LANES(num::kernels::sub(FRAC_A, FRAC_B));
+    mul:
+        FRAC_LANES(num::kernels::mul(FRAC_A, FRAC_B));
+    neg:
+        FRAC_LANES(num::kernels::neg(FRAC_A));
+    sqr:
+        FRAC_LANES(num::kernels::sqr(FRAC_A));
+    sqrt:
+        FRAC_LANES(num::kernels::sqrt(FRAC_A));
+    abs:
+        FRAC_LANES(num::kernels::abs(FRAC_A));
+    min:
+        FRAC_LANES(num::kernels::min(FRAC_A, FRAC_B));
+    max:
+        FRAC_LANES(num::kernels::max(FRAC_A, FRAC_B));
+    powi:
+        FRAC_LANES(num::powi(FRAC_A, immediate(*ins)));
+    other:
+        FRAC_LANES(apply_other(*ins, r, L, j));
+#undef FRAC_LANES
+#undef FRAC_A
+#undef FRAC_B
+    done:
+        for (std::size_t j = 0; j < n; ++j) out[j] = r[code_->result * L + j];
+        file.last_eval = id_;
+        file.last_file = &regs;
+        file.last_first = 0;
+        file.last_count = n;
+    }
+
+    static Interval apply_other(const FlatInstr& ins, const Interval* r, std::size_t stride,
+                                std::size_t lane) {
+        Interval args[3];
+        for (int i = 0; i < ir::arity(ins.op); ++i)
+            args[i] = r[ins.in[static_cast<std::size_t>(i)] * stride + lane];
+        return ir::apply_interval(ins.op, args, 0);
+    }
+
     template <class V>
     void load(V* r, const V* inputs) const {
-        const std::vector<Slot>& slots = code_->root->input_slots;
-        for (std::size_t k = 0; k < slots.size(); ++k)
-            if (slots[k] != ir::no_slot) r[slots[k]] = inputs[k];
+        std::copy_n(inputs, code_->inputs, r + code_->first_input());
     }
 
-    // One box, upward rounding already set.
-    Interval run_box(const Interval* box) {
-        ++stats.calls;
-        ThreadFile& file = thread_file();
-        Interval* r = file.boxes_of(*code_->root);
-        load(r, box);
-        for (const FlatInstr& ins : code_->code) {
-            const Interval a = r[ins.in[0]];
-            Interval& out = r[ins.out];
-            switch (ins.op) {
-            case Op::Add: out = num::add(a, r[ins.in[1]]); break;
-            case Op::Sub: out = num::sub(a, r[ins.in[1]]); break;
-            case Op::Mul: out = num::mul(a, r[ins.in[1]]); break;
-            case Op::Neg: out = num::neg(a); break;
-            case Op::Sqr: out = num::sqr(a); break;
-            case Op::Sqrt: out = num::sqrt(a); break;
-            case Op::Abs: out = num::abs(a); break;
-            case Op::Min: out = num::min(a, r[ins.in[1]]); break;
-            case Op::Max: out = num::max(a, r[ins.in[1]]); break;
-            case Op::PowI: out = num::powi(a, immediate(ins)); break;
-            default: {
-                Interval args[3];
-                for (int i = 0; i < ir::arity(ins.op); ++i) args[i] = r[ins.in[static_cast<std::size_t>(i)]];
-                out = ir::apply_interval(ins.op, args, 0);
-            }
-            }
-        }
-        file.last_eval = id_;
-        return r[code_->result];
-    }
-
-    static bool defined(const FlatInstr& ins, const Interval* r) {
+    static bool defined(const FlatInstr& ins, const BoxValues& r) {
         const Interval a = r[ins.in[0]];
         return ir::defined_over_box(ins.op, a, ir::arity(ins.op) > 1 ? r[ins.in[1]] : a, immediate(ins));
     }
@@ -205,107 +338,149 @@ private:
     // Marks in file.may_empty the slots whose enclosure can become empty on a sub-box (the
     // reference's emptiness analysis, on values alone: every slot of a flat tape has one). False,
     // without a pass, when none can: every partial operation is defined over the box.
-    bool mark_may_empty(ThreadFile& file, const Interval* r) const {
+    bool mark_may_empty(ThreadFile& file, const BoxValues& r) const {
         const FlatCode& c = *code_;
         bool any = false;
-        for (Slot s : c.root->input_slots) any |= s != ir::no_slot && r[s].is_empty();
+        for (Slot s = c.first_input(); s < c.first_result(); ++s) any |= r[s].is_empty();
         for (std::size_t k = 0; k < c.partial.size() && !any; ++k) {
             const FlatInstr& ins = c.code[c.partial[k]];
             any = !defined(ins, r);
         }
         if (!any) return false;
-        for (Slot s : c.root->input_slots)
-            if (s != ir::no_slot) file.may_empty[s] = r[s].is_empty();
+        std::fill_n(file.may_empty.begin(), c.constant_count(), 0);
+        for (Slot s = c.first_input(); s < c.first_result(); ++s) file.may_empty[s] = r[s].is_empty();
         for (const FlatInstr& ins : c.code) {
             bool empty = false;
-            for (int i = 0; i < ir::arity(ins.op); ++i) empty |= file.may_empty[ins.in[static_cast<std::size_t>(i)]] != 0;
+            for (int i = 0; i < ir::arity(ins.op); ++i)
+                empty |= file.may_empty[ins.in[static_cast<std::size_t>(i)]] != 0;
             if (!empty && is_partial(ins.op)) empty = !defined(ins, r);
             file.may_empty[ins.out] = empty;
         }
         return true;
     }
 
-    // A tape push: the pruned tape of the box, for this cell's descendants alone. `evaluated`: the
-    // thread's register file holds the box's values (checked: else it is evaluated again).
-    std::shared_ptr<ir::Evaluator> push(const Interval* box, double expected_evaluations, bool evaluated) {
+    // A tape push: the pruned tape of the box, for this cell's descendants alone. The values are those
+    // of box k of this evaluator's last evaluation (checked: else the box is evaluated again).
+    std::shared_ptr<ir::Evaluator> push(const Interval* box, std::size_t k, double expected_evaluations) {
         const FlatCode& c = *code_;
         if (!options_.prune || !c.has_choices || expected_evaluations <= interp_min_expected_evaluations)
             return nullptr;
         const auto t0 = std::chrono::steady_clock::now();
         ThreadFile& file = thread_file();
-        if (!evaluated || file.last_eval != id_) {
+        if (file.last_eval != id_ || k < file.last_first || k - file.last_first >= file.last_count) {
             const ir::EvalStats saved = stats;
             eval_box(box);
             stats = saved; // a recording is not an evaluation of the shape
+            k = 0;
         }
-        const Interval* r = file.boxes.data();
+        const std::size_t stride = file.last_file == &file.single ? 1 : lanes;
+        const BoxValues r{file.last_file->values.data(), stride, k - file.last_first};
+        file.prepare_push(c);
         const bool empties = mark_may_empty(file, r);
         const auto t1 = std::chrono::steady_clock::now();
         specialize_stats.record_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();
         ++specialize_stats.requests;
 
-        // Backward: the choices of the live code, and what stays live.
-        const std::uint32_t gen = file.next_generation(c.root->num_slots);
-        if (file.pick.size() < c.code.size()) file.pick.resize(c.code.size());
-        std::uint32_t* live = file.live.data();
-        live[c.result] = gen;
-        std::size_t kept = 0;
-        bool decided = false;
-        for (std::size_t k = c.code.size(); k-- > 0;) {
-            const FlatInstr& ins = c.code[k];
+        // Backward, from the result: the live code, each decided choice replaced by the operand it
+        // takes. Slots reached get names: constants and inputs tagged, results numbered as reached;
+        // a choice's result is an alias of its operand's name (or the operand, computed earlier,
+        // takes the choice's name). The code goes to file.reversed, the parent's order reversed.
+        const std::uint32_t gen = file.next_generation();
+        std::uint32_t* const live = file.live.data();
+        std::uint32_t* const name = file.name.data();
+        std::uint32_t* const alias = file.alias.data();
+        file.reversed.clear();
+        file.constants.clear();
+        std::uint32_t results = 0;
+        const Slot first_input = c.first_input(), first_result = c.first_result();
+        const auto name_of = [&](Slot s) __attribute__((always_inline)) {
+            if (live[s] == gen) return name[s];
+            live[s] = gen;
+            std::uint32_t n;
+            if (s < first_input) {
+                n = constant_tag | static_cast<std::uint32_t>(file.constants.size());
+                file.constants.push_back(s);
+            } else if (s < first_result) {
+                n = input_tag | (s - first_input);
+            } else {
+                n = results++;
+                alias[n] = no_alias;
+            }
+            return name[s] = n;
+        };
+        const std::uint32_t result = name_of(c.result);
+        const double max_cost = ir::push_max_cost(static_cast<double>(c.code.size()), expected_evaluations);
+        std::size_t partial = 0;
+        bool decided = false, too_long = false;
+        for (std::size_t i = c.code.size(); i-- > 0;) {
+            const FlatInstr& ins = c.code[i];
             if (live[ins.out] != gen) continue;
-            std::uint8_t pick = 0;
+            const std::uint32_t out = name[ins.out];
             if (ir::is_choice(ins.op)) {
-                const ir::Choice choice =
-                    ir::decide_choice(ins.op, r[ins.in[0]], r[ins.in[1]], empties && file.may_empty[ins.in[0]],
-                                      empties && file.may_empty[ins.in[1]]);
-                if (choice != ir::Choice::both)
-                    pick = static_cast<std::uint8_t>(1 + (ins.op == Op::Select ? 1 : 0) +
-                                                     (choice == ir::Choice::second ? 1 : 0));
+                const ir::Choice choice = ir::decide_choice(ins.op, r[ins.in[0]], r[ins.in[1]],
+                                                            empties && file.may_empty[ins.in[0]],
+                                                            empties && file.may_empty[ins.in[1]]);
+                if (choice != ir::Choice::both) {
+                    decided = true;
+                    const Slot taken =
+                        ins.in[(ins.op == Op::Select ? 1 : 0) + (choice == ir::Choice::second ? 1 : 0)];
+                    if (live[taken] != gen && taken >= first_result) {
+                        live[taken] = gen;
+                        name[taken] = out;
+                    } else {
+                        alias[out] = name_of(taken);
+                    }
+                    continue;
+                }
             }
-            file.pick[k] = pick;
-            if (pick) {
-                live[ins.in[pick - 1u]] = gen;
-                decided = true;
-                continue;
+            // Past the most it may cost, with a choice decided: too little pruned (else nothing is).
+            if (decided && static_cast<double>(file.reversed.size() + 1) > max_cost) {
+                too_long = true;
+                break;
             }
-            ++kept;
-            for (int i = 0; i < ir::arity(ins.op); ++i) live[ins.in[static_cast<std::size_t>(i)]] = gen;
+            // Written in place: a copy built field by field and then moved whole stalls on the
+            // store forwarding of its fields.
+            FlatInstr& n = file.reversed.emplace_back(ins);
+            n.out = out;
+            for (int a = 0; a < ir::arity(ins.op); ++a)
+                n.in[static_cast<std::size_t>(a)] = name_of(ins.in[static_cast<std::size_t>(a)]);
+            partial += is_partial(ins.op);
         }
-        if (!decided) {
-            ++specialize_stats.unpruned;
-            specialize_stats.prune_ms += elapsed_ms(t1);
-            return nullptr;
-        }
-        if (static_cast<double>(kept) > ir::push_max_cost(static_cast<double>(c.code.size()), expected_evaluations)) {
-            ++specialize_stats.too_little;
+        too_long |= static_cast<double>(file.reversed.size()) > max_cost;
+        if (too_long || !decided) {
+            ++(decided ? specialize_stats.too_little : specialize_stats.unpruned);
             specialize_stats.prune_ms += elapsed_ms(t1);
             return nullptr;
         }
 
-        // Forward: the live code, each chosen operand in place of its choice.
-        auto pruned = std::make_shared<FlatCode>();
-        pruned->root = c.root;
-        pruned->code.reserve(kept);
-        file.aliased.clear();
-        Slot* remap = file.remap.data();
-        for (std::size_t k = 0; k < c.code.size(); ++k) {
-            const FlatInstr& ins = c.code[k];
-            if (live[ins.out] != gen) continue;
-            if (const std::uint8_t pick = file.pick[k]) {
-                remap[ins.out] = remap[ins.in[pick - 1u]];
-                file.aliased.push_back(ins.out);
-                continue;
-            }
-            FlatInstr n = ins;
-            for (int i = 0; i < ir::arity(ins.op); ++i)
-                n.in[static_cast<std::size_t>(i)] = remap[ins.in[static_cast<std::size_t>(i)]];
-            if (is_partial(ins.op)) pruned->partial.push_back(static_cast<std::uint32_t>(pruned->code.size()));
-            pruned->has_choices |= ir::is_choice(ins.op);
-            pruned->code.push_back(n);
+        // Forward: the pruned tape in dense slots, results numbered in program order.
+        const std::size_t count = file.reversed.size();
+        std::shared_ptr<FlatCode> pruned = FlatCode::make(c.inputs, file.constants.size(), count, partial);
+        for (std::size_t k = 0; k < file.constants.size(); ++k) {
+            pruned->constants[k] = c.constants[file.constants[k]];
+            pruned->constant_points[k] = c.constant_points[file.constants[k]];
         }
-        pruned->result = remap[c.result];
-        for (Slot s : file.aliased) remap[s] = s;
+        std::uint32_t* const final_slot = file.final_slot.data();
+        const Slot inputs_at = pruned->first_input();
+        const auto slot_of = [&](std::uint32_t n) -> Slot {
+            while (!(n & (constant_tag | input_tag)) && alias[n] != no_alias) n = alias[n];
+            if (n & constant_tag) return n & ~constant_tag;
+            if (n & input_tag) return inputs_at + (n & ~input_tag);
+            return final_slot[n];
+        };
+        Slot next = pruned->first_result();
+        std::size_t partial_at = 0;
+        for (std::size_t k = 0; k < count; ++k) {
+            FlatInstr& n = pruned->code[k];
+            n = file.reversed[count - 1 - k];
+            for (int a = 0; a < ir::arity(n.op); ++a)
+                n.in[static_cast<std::size_t>(a)] = slot_of(n.in[static_cast<std::size_t>(a)]);
+            final_slot[n.out] = next;
+            n.out = next++;
+            if (is_partial(n.op)) pruned->partial[partial_at++] = static_cast<std::uint32_t>(k);
+            pruned->has_choices |= ir::is_choice(n.op);
+        }
+        pruned->result = slot_of(result);
         ++specialize_stats.pushes;
         specialize_stats.prune_ms += elapsed_ms(t1);
         return std::make_shared<FlatInterpreter>(std::move(pruned), options_);
@@ -333,23 +508,40 @@ std::unique_ptr<ir::Evaluator> make_flat_interpreter(const ir::Tape& tape, const
     if (!runs_flat(tape)) throw std::logic_error("make_flat_interpreter: the tape is not flat");
     if (options.max_terms < 1 || options.max_terms > ir::max_terms_limit)
         throw std::invalid_argument("max_terms out of range");
-    auto root = std::make_shared<FlatRoot>();
-    root->id = next_id();
-    root->inputs = tape.inputs;
-    root->num_slots = tape.num_slots;
-    root->constants = tape.constants;
-    root->input_slots = tape.input_slots;
-    auto code = std::make_shared<FlatCode>();
-    code->root = root;
-    code->result = tape.result;
-    code->code.reserve(tape.blocks[0].size());
-    for (const ir::Instr& ins : tape.blocks[0]) {
-        FlatInstr n{ins.out, ins.in, ins.op};
-        if (ins.op == Op::PowI) n.in[1] = static_cast<Slot>(static_cast<std::int32_t>(ins.imm));
-        if (is_partial(ins.op)) code->partial.push_back(static_cast<std::uint32_t>(code->code.size()));
-        code->has_choices |= ir::is_choice(ins.op);
-        code->code.push_back(n);
+    // Dense slots: constants, inputs, then results in program order.
+    const std::vector<ir::Instr>& instructions = tape.blocks[0];
+    std::size_t partial = 0;
+    for (const ir::Instr& ins : instructions) partial += is_partial(ins.op);
+    std::shared_ptr<FlatCode> code =
+        FlatCode::make(tape.inputs, tape.constants.size(), instructions.size(), partial);
+    std::vector<Slot> renumber(tape.num_slots, ir::no_slot);
+    for (std::size_t k = 0; k < tape.constants.size(); ++k) {
+        renumber[tape.constants[k].slot] = static_cast<Slot>(k);
+        code->constants[k] = tape.constants[k].value;
+        code->constant_points[k] = tape.constants[k].point;
     }
+    for (std::size_t k = 0; k < tape.input_slots.size(); ++k)
+        if (tape.input_slots[k] != ir::no_slot)
+            renumber[tape.input_slots[k]] = code->first_input() + static_cast<Slot>(k);
+    const auto slot = [&](Slot s) {
+        if (s >= renumber.size() || renumber[s] == ir::no_slot)
+            throw std::logic_error("make_flat_interpreter: a slot is read before it is written");
+        return renumber[s];
+    };
+    Slot next = code->first_result();
+    std::size_t partial_at = 0;
+    for (std::size_t k = 0; k < instructions.size(); ++k) {
+        const ir::Instr& ins = instructions[k];
+        FlatInstr n = flat_instr(ins.op, ins.out, ins.in);
+        for (int i = 0; i < ir::arity(ins.op); ++i)
+            n.in[static_cast<std::size_t>(i)] = slot(ins.in[static_cast<std::size_t>(i)]);
+        if (ins.op == Op::PowI) n.in[1] = static_cast<Slot>(static_cast<std::int32_t>(ins.imm));
+        n.out = renumber[ins.out] = next++;
+        if (is_partial(ins.op)) code->partial[partial_at++] = static_cast<std::uint32_t>(k);
+        code->has_choices |= ir::is_choice(ins.op);
+        code->code[k] = n;
+    }
+    code->result = slot(tape.result);
     return std::make_unique<FlatInterpreter>(std::move(code), options);
 }
 

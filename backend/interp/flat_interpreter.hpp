@@ -1,11 +1,16 @@
 // The interpreter of flat tapes (one block: no series, no external functions), the form large
-// F-rep models take. Built for tape pushes (libfive's, Fidget's): a pruned tape keeps its root's
-// slot numbering, so every tape pushed from one root runs in one register file per thread, and a push
-// is two passes over the parent's code (a backward pass deciding the choices from the values its
-// evaluation left and marking the live code, a forward pass copying it with the chosen operands in
-// place of the choices) into compact 20-byte instructions, without renumbering, hashing or extra
-// allocation. Results are the reference interpreter's bit for bit: the same interval operations, the
-// same choices (ir::decide_choice) and emptiness rule (ir::defined_over_box).
+// F-rep models take; make_interpreter uses it for every flat tape.
+//
+// Built for tape pushes (libfive's, Fidget's): a box evaluation leaves every value in the thread's
+// register file, and a push reads the choices off those values in one backward pass over the live
+// code, writing the pruned tape in reverse, then one forward pass over the pruned code that numbers
+// its slots densely (constants, inputs, results), so a deep cell's registers are a few cache lines.
+// Instructions are 20 bytes with their handler resolved; a tape's arrays share one allocation. Box
+// evaluation runs up to `lanes` boxes side by side (a cover's sibling cells share their parent's
+// tape), dispatching each instruction once for all of them.
+//
+// Results are the tape interpreter's bit for bit (tests/unit/llvm/test_flat_interpreter.cpp): the same
+// interval operations, the same choices (ir::decide_choice) and emptiness rule (ir::defined_over_box).
 #pragma once
 
 #include "ir/evaluator.hpp"

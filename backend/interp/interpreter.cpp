@@ -1,5 +1,7 @@
 #include "backend/interp/interpreter.hpp"
 
+#include "backend/interp/flat_interpreter.hpp"
+
 #include "ir/semantics.hpp"
 #include "ir/series_tail.hpp"
 
@@ -49,10 +51,11 @@ public:
     std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
         return push(box, expected_evaluations, false);
     }
-    // The register file still holds the values of eval_box(box): no second evaluation.
-    std::shared_ptr<ir::Evaluator> specialize_after_eval(const Interval* box,
+    // The register file holds the values of the last box evaluated: no second evaluation.
+    std::size_t kept_evaluations() const override { return 1; }
+    std::shared_ptr<ir::Evaluator> specialize_after_eval(std::size_t k, const Interval* box,
                                                          double expected_evaluations) override {
-        return push(box, expected_evaluations, true);
+        return push(box, expected_evaluations, k == 0 && evaluated_boxes_ == 1);
     }
 
     // A tape push: the pruned tape of the box, made for this cell's descendants alone (no cache: a
@@ -97,6 +100,7 @@ public:
 
     Interval eval_box(const Interval* box) override {
         ++stats.calls;
+        evaluated_boxes_ = 1;
         num::UpwardRounding up;
         load(boxes_, box);
         run_boxes(0);
@@ -106,6 +110,7 @@ public:
     void eval_boxes(const Interval* boxes, std::size_t n, Interval* out) override {
         num::UpwardRounding up; // once per batch
         const auto d = static_cast<std::size_t>(tape_.inputs);
+        evaluated_boxes_ = n;
         for (std::size_t i = 0; i < n; ++i) {
             ++stats.calls;
             load(boxes_, boxes + i * d);
@@ -324,11 +329,17 @@ private:
     double cost_;      // ir::tape_cost of the tape
     std::vector<Interval> boxes_;
     std::vector<double> points_;
+    std::size_t evaluated_boxes_ = 0; // boxes of the last box evaluation (boxes_ holds the last one's)
 };
 
 } // namespace
 
 std::unique_ptr<ir::Evaluator> make_interpreter(ir::Tape tape, const ir::EvalOptions& options) {
+    if (runs_flat(tape)) return make_flat_interpreter(tape, options);
+    return make_tape_interpreter(std::move(tape), options);
+}
+
+std::unique_ptr<ir::Evaluator> make_tape_interpreter(ir::Tape tape, const ir::EvalOptions& options) {
     return std::make_unique<Interpreter>(std::move(tape), options);
 }
 

@@ -9,7 +9,12 @@
 
 namespace frac::interp {
 
+// Flat tapes (backend/interp/flat_interpreter.hpp) run on the flat interpreter, others on the tape
+// interpreter below.
 std::unique_ptr<ir::Evaluator> make_interpreter(ir::Tape tape, const ir::EvalOptions& options = {});
+// The interpreter of any tape (series and external functions included), instruction by instruction:
+// the reference the flat interpreter is tested against.
+std::unique_ptr<ir::Evaluator> make_tape_interpreter(ir::Tape tape, const ir::EvalOptions& options = {});
 
 // What specialising costs the interpreter (a tape copy, no compilation), measured by bench/bench_prune.
 inline constexpr ir::PruneCosts interp_prune_costs{/*eval_ns_per_cost=*/33.0, /*compile_ns_fixed=*/2000.0,

@@ -31,7 +31,8 @@ ir::NodeId choice_tree(ir::Graph& g, BoxMaker& mk, int depth) {
     static const ir::Op ops[] = {ir::Op::Min, ir::Op::Max, ir::Op::Add, ir::Op::Select};
     const ir::Op op = ops[mk.pick(4)];
     const ir::NodeId a = choice_tree(g, mk, depth - 1), b = choice_tree(g, mk, depth - 1);
-    if (op == ir::Op::Select) return g.op(op, g.op(ir::Op::Lt, g.var(0), g.constant(mk.uniform(-1, 1))), a, b);
+    if (op == ir::Op::Select)
+        return g.op(op, g.op(ir::Op::Lt, g.var(0), g.constant(mk.uniform(-1, 1))), a, b);
     return g.op(op, a, b);
 }
 
@@ -79,7 +80,8 @@ TEST_CASE("the flat interpreter agrees with the tape interpreter bit for bit", "
         for (int k = 0; k < 20; ++k) {
             const double p[2] = {mk.position({-2, 2}), mk.position({-2, 2})};
             const double a = flat->eval_point(p), b = ref->eval_point(p);
-            INFO("point (" << hex(p[0]) << ", " << hex(p[1]) << "): flat " << hex(a) << ", reference " << hex(b));
+            INFO("point (" << hex(p[0]) << ", " << hex(p[1]) << "): flat " << hex(a) << ", reference "
+                           << hex(b));
             REQUIRE(same(a, b));
         }
     }
@@ -103,7 +105,8 @@ TEST_CASE("flat tape pushes compute what ir::specialize's tapes compute, from an
         REQUIRE(flat->kept_evaluations() >= 1);
         for (int trial = 0; trial < 6; ++trial) {
             // A batch of up to kept_evaluations() boxes (a cover's sibling cells), then every box's push.
-            const std::size_t m = 1 + static_cast<std::size_t>(mk.pick(static_cast<int>(flat->kept_evaluations())));
+            const std::size_t m =
+                1 + static_cast<std::size_t>(mk.pick(static_cast<int>(flat->kept_evaluations())));
             std::vector<std::vector<Interval>> boxes;
             std::vector<Interval> flat_boxes;
             for (std::size_t k = 0; k < m; ++k) {
@@ -118,7 +121,8 @@ TEST_CASE("flat tape pushes compute what ir::specialize's tapes compute, from an
                 auto push = flat->specialize_after_eval(k, box.data(), 1e12);
                 const std::vector<ir::Choice> choices = recorder.record(box.data());
                 const ir::Tape expected = ir::specialize(t, choices);
-                const bool prunes = ir::any_decided(choices) && expected.instruction_count() < t.instruction_count();
+                const bool prunes =
+                    ir::any_decided(choices) && expected.instruction_count() < t.instruction_count();
                 INFO("trial " << trial << ", box " << k << " of " << m << ": " << hex_box(box.data(), 2));
                 REQUIRE(bool(push) == prunes);
                 if (!push) continue;
@@ -131,13 +135,18 @@ TEST_CASE("flat tape pushes compute what ir::specialize's tapes compute, from an
                     const Interval a = push->eval_box(sub.data()), b = ref->eval_box(sub.data());
                     INFO(mismatch("sub-box", static_cast<std::size_t>(s), a, b));
                     REQUIRE(same(a, b));
-                    REQUIRE(same(a, flat->eval_box(sub.data())));
                     const double p[2] = {sub[0].lo, sub[1].hi};
                     REQUIRE(same(push->eval_point(p), ref->eval_point(p)));
+                    // (Not compared with the whole tape: pow's domain depends on whether its exponent is
+                    // thin, so enclosures are not inclusion isotone, and a pruned tape may differ.)
                     if (auto again = push->specialize_after_eval(0, sub.data(), 1e12)) {
                         ++nested;
+                        const ir::Tape expected_again =
+                            ir::specialize(expected, interp::ChoiceRecorder(expected, {}).record(sub.data()));
+                        CHECK(again->instruction_count() == expected_again.instruction_count());
                         const std::vector<Interval> leaf = sub_box_of(mk, sub);
-                        REQUIRE(same(again->eval_box(leaf.data()), flat->eval_box(leaf.data())));
+                        REQUIRE(same(again->eval_box(leaf.data()),
+                                     interp::make_tape_interpreter(expected_again)->eval_box(leaf.data())));
                     }
                 }
             }

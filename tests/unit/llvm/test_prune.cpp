@@ -199,7 +199,7 @@ TEST_CASE("the interpreter prunes from the values its last evaluation left", "[l
     for (int k = 0; k < 200; ++k) {
         const std::vector<Interval> box = sub_box(r, {{0, 2}, {0, 1}});
         const Interval value = a->eval_box(box.data());
-        auto after = a->specialize_after_eval(box.data(), 1e12);
+        auto after = a->specialize_after_eval(0, box.data(), 1e12);
         auto fresh = b->specialize(box.data(), 1e12);
         REQUIRE(bool(after) == bool(fresh));
         if (!after) continue;
