@@ -12,10 +12,6 @@
 
 namespace frac::ir {
 
-bool is_choice(Op op) {
-    return op == Op::Min || op == Op::Max || op == Op::And || op == Op::Or || op == Op::Select;
-}
-
 bool has_choices(const Tape& tape) {
     if (tape.blocks.empty()) return false;
     for (const Instr& ins : tape.blocks[0])

@@ -34,7 +34,9 @@ namespace frac::ir {
 enum class Choice : std::uint8_t { both, first, second };
 
 // Min, Max, And, Or, Select.
-bool is_choice(Op op);
+inline bool is_choice(Op op) {
+    return op == Op::Min || op == Op::Max || op == Op::And || op == Op::Or || op == Op::Select;
+}
 // Whether block 0 of the tape has a choice instruction (else nothing can ever be pruned).
 bool has_choices(const Tape& tape);
 
