@@ -86,9 +86,9 @@ public:
         }
     }
 
-    // FRAC_JIT_EXACT_CALLS=1 in the environment: sqrt, sin, cos, exp, tan, log and pow call the numeric core
-    // (correctly rounded, bit for bit the interpreter's) instead of the inline kernels; for benchmarks and
-    // tests.
+    // FRAC_JIT_EXACT_CALLS=1 in the environment: sqrt, sin, cos, exp, tan, log, pow and atan2 call the
+    // numeric core (correctly rounded, bit for bit the interpreter's) instead of the inline kernels; for
+    // benchmarks and tests.
     static bool exact_calls_requested() {
         const char* v = std::getenv("FRAC_JIT_EXACT_CALLS");
         return v && std::string(v) == "1";
@@ -360,6 +360,11 @@ private:
     // pow(x, y) = exp(y log x) for a positive base and an exponent that is not a thin integer (those take
     // powi's exact path in the core).
     SlotState op_pow(const SlotState& a, const SlotState& b);
+    // atan2(y, x) over a box: the core's cases for the origin and the cut, elsewhere the angles at the two
+    // extreme corners with a proven error bound (box_kernels.cpp).
+    SlotState op_atan2(const SlotState& a, const SlotState& b);
+    // An approximation of atan2(y, x) for finite (y, x) != (0, 0), error below 2^-47 |v| + 2^-1060.
+    Value* atan2_value(Value* y, Value* x);
     SlotState op_powi(const SlotState& a, std::int64_t n);
     SlotState op_minmax(const SlotState& a, const SlotState& b, bool is_min);
     SlotState op_round(const SlotState& a, bool up);
@@ -407,8 +412,8 @@ private:
     SlotState emit_series(const Instr& ins);
 
     bool avx512_;
-    bool fast_kernels_; // inline sqrt, sin, cos, exp, tan, log, pow (FRAC_JIT_EXACT_CALLS=1: the numeric
-                        // core's calls)
+    bool fast_kernels_; // inline sqrt, sin, cos, exp, tan, log, pow, atan2 (FRAC_JIT_EXACT_CALLS=1: the
+                        // numeric core's calls)
     Type *vt_, *mt_, *vi64_;
     Value* scratch_in_ = nullptr;
     Value* scratch_n_ = nullptr;

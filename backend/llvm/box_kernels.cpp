@@ -1,7 +1,7 @@
 // Interval kernels of box code computed inline in vector form instead of calling the numeric core lane
 // by lane (see box_gen.hpp): sqrt with directed rounding, sin and cos by range reduction and
-// polynomials with a proven error bound, exp and log likewise, tan from the sin and cos enclosures. Lanes
-// a kernel cannot handle call the core.
+// polynomials with a proven error bound, exp and log likewise, tan from the sin and cos enclosures, atan2
+// from two corners of the box. Lanes a kernel cannot handle call the core.
 #include "backend/llvm/box_gen.hpp"
 
 #include <iterator>
@@ -78,6 +78,32 @@ constexpr double log_coeffs[] = {1.0 / 21, 1.0 / 19, 1.0 / 17, 1.0 / 15, 1.0 / 1
                                  1.0 / 9,  1.0 / 7,  1.0 / 5,  1.0 / 3,  1.0};
 // |v - log(x)| <= log_rel_bound |v| + abs_floor (docs/design.md, "Vector interval kernels").
 constexpr double log_rel_bound = 0x1p-47;
+
+// atan2: t = min(|y|, |x|) / max(|y|, |x|) in [0, 1], c = k/4 nearest t (k = 0 .. 4), atan t = atan c +
+// atan u with u = (t - c) / (1 + t c), |u| <= 0.1251; atan c = hi + lo (|residue| < 2^-109).
+constexpr double atan_quarter_hi[] = {0.0, 0x1.f5b75f92c80ddp-3, 0x1.dac670561bb4fp-2, 0x1.4978fa3269ee1p-1,
+                                      0x1.921fb54442d18p-1};
+constexpr double atan_quarter_lo[] = {0.0, 0x1.8ab6e3cf7afbdp-57, 0x1.a2b7f222f65e2p-56,
+                                      0x1.2419a87f2a458p-56, 0x1.1a62633145c07p-55};
+// atan u = u Q(u^2), Q(z) = sum (-1)^n z^n / (2n + 1): coefficients RN(+-1/(2n + 1)), n = 9 .. 0.
+constexpr double atan_coeffs[] = {-1.0 / 19, 1.0 / 17, -1.0 / 15, 1.0 / 13, -1.0 / 11,
+                                  1.0 / 9,   -1.0 / 7, 1.0 / 5,   -1.0 / 3, 1.0};
+// The error bound of a corner's angle v: |v - atan2(y, x)| <= atan2_rel_bound |v| + abs_floor. Each
+// operation errs by less than 2^-52 relative (one ulp, any rounding direction); u = 2^-52:
+//  - t: 1u; through atan (slope 1 / (1 + t^2), atan t >= t pi/4 on [0, 1]) at most 1.28u atan t;
+//  - u: the difference, 1 + t c (an fma) and the quotient, 3u relative; slope <= 1: 3u |atan u|;
+//  - Q: truncation |u|^21 / 21 < 2^-64 |u| (alternating series, z <= 0.0157); Horner with fma and
+//    rounded coefficients below 1.6u (each step's error damped by z), the product u Q 1u: in all
+//    atan u within 6.1u |u| (|u| <= 1.006 |atan u|);
+//  - r = hi + (lo + p) for atan t: for k = 0 exactly p (relative 6.2u); for k >= 1, atan t >= 0.124,
+//    and the errors 6.1u 0.1251 + 0.127u + 1u atan t stay below 10u atan t; with t's 1.28u: 11.3u;
+//  - pi/2 - r (|y| > |x|, r <= 0.786, result >= 0.785): (H1 - r) + H2, two roundings of 1.571u each
+//    plus 11.3u 0.786, below 12.1u absolute, 15.4u of the result; pi - r (x < 0, r <= pi/2, result
+//    >= pi/2): r's 12.1u and two roundings of 3.15u each, 18.4u absolute, below 11.8u of the result.
+// Below 16u |v| = 2^-48 |v| to first order; the bound doubles it for the second-order terms.
+// Subnormal t (or u Q) adds a few 2^-1074, within abs_floor.
+constexpr double atan2_rel_bound = 0x1p-47;
+constexpr double pi_up = 0x1.921fb54442d19p+1; // RU(pi), the core's bound of the range
 
 } // namespace
 
@@ -238,6 +264,64 @@ SlotState BoxGen::op_log(const SlotState& a) {
     // numeric/interval.cpp: empty when a is empty or a.hi <= 0, a lower bound <= 0 gives -inf; those
     // lanes call the core.
     return result(with_fallback(positive_normal(a.v), log_bounds(a.v), Op::Log, {&a}), true);
+}
+
+Value* BoxGen::atan2_value(Value* y, Value* x) {
+    // For finite (y, x) != (0, 0); y = -0 counts as +0 (the core's corners see -0 only where it does not
+    // matter or after making it +0).
+    Value* ay = fabs(y);
+    Value* ax = fabs(x);
+    Value* steep = gt(ay, ax);
+    Value* t = div(sel(steep, ax, ay), sel(steep, ay, ax));
+    Value* k = floor(add(mul(t, cst(4.0)), cst(0.5)));
+    Value* c = mul(k, cst(0.25));
+    Value* u = div(sub(t, c), fma(t, c, cst(1.0)));
+    Value* z = mul(u, u);
+    Value* q = cst(atan_coeffs[0]);
+    for (std::size_t i = 1; i < std::size(atan_coeffs); ++i) q = fma(q, z, cst(atan_coeffs[i]));
+    Value* base_hi = cst(0.0);
+    Value* base_lo = cst(0.0);
+    for (std::size_t i = 1; i < std::size(atan_quarter_hi); ++i) {
+        Value* is_k = eq(k, cst(static_cast<double>(i)));
+        base_hi = sel(is_k, cst(atan_quarter_hi[i]), base_hi);
+        base_lo = sel(is_k, cst(atan_quarter_lo[i]), base_lo);
+    }
+    Value* r = add(base_hi, add(base_lo, mul(u, q))); // atan t
+    r = sel(steep, add(sub(cst(half_pi_1), r), cst(half_pi_2)), r);
+    r = sel(lt(x, cst(0.0)), add(sub(cst(2 * half_pi_1), r), cst(2 * half_pi_2)), r);
+    return sel(lt(y, cst(0.0)), neg(r), r);
+}
+
+SlotState BoxGen::op_atan2(const SlotState& a, const SlotState& b) {
+    const IV& y = a.v;
+    const IV& x = b.v;
+    // numeric/interval.cpp: a box in the closed upper half-plane (y.lo = 0) meeting x = 0 gives [0, pi];
+    // otherwise one containing the origin or meeting the cut (x < 0, y = 0), [-pi, pi].
+    Value* upper = land(eq(y.lo, cst(0.0)), ge(y.hi, cst(0.0)));
+    Value* half_range = land(upper, land(le(x.lo, cst(0.0)), ge(x.hi, cst(0.0))));
+    Value* whole_range =
+        land(lnot(upper), land(le(x.lo, cst(0.0)), land(le(y.lo, cst(0.0)), ge(y.hi, cst(0.0)))));
+    // Elsewhere the angle is continuous on the box, its extremes at corners: above the x axis it falls
+    // with x, below it rises, on the right half-plane it rises with y; along y it rises where x > 0 and
+    // falls where x < 0. So the least angle is at x.hi (y >= 0) or x.lo, the greatest at x.hi (y < 0)
+    // or x.lo, each with the y end that x's sign picks.
+    Value* x_min = sel(ge(y.lo, cst(0.0)), x.hi, x.lo);
+    Value* y_min = sel(ge(x_min, cst(0.0)), y.lo, y.hi);
+    Value* x_max = sel(lt(y.hi, cst(0.0)), x.hi, x.lo);
+    Value* y_max = sel(ge(x_max, cst(0.0)), y.hi, y.lo);
+    Value* at_min = atan2_value(y_min, x_min);
+    Value* at_max = atan2_value(y_max, x_max);
+    auto err = [&](Value* v) { return add(mul(fabs(v), cst(atan2_rel_bound)), cst(abs_floor)); };
+    Value* lo = std_max(sub_down(at_min, err(at_min)), cst(-pi_up));
+    Value* hi = std_min(add(at_max, err(at_max)), cst(pi_up));
+    lo = sel(half_range, cst(0.0), sel(whole_range, cst(-pi_up), lo));
+    hi = sel(b_.CreateOr(half_range, whole_range), cst(pi_up), hi);
+    // Infinite ends (and NaN) call the core; empty lanes give the empty interval.
+    Value* finite = land(land(is_finite(y.lo), is_finite(y.hi)), land(is_finite(x.lo), is_finite(x.hi)));
+    Value* e = lor(empty_of(a), empty_of(b));
+    Value* fast = lor(e, b_.CreateOr(b_.CreateOr(half_range, whole_range), finite));
+    const IV r = guard(e, {lo, hi}, empty());
+    return result(with_fallback(fast, r, Op::Atan2, {&a, &b}), a.f.maybe_empty || b.f.maybe_empty);
 }
 
 SlotState BoxGen::op_pow(const SlotState& a, const SlotState& b) {

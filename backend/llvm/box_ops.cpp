@@ -255,7 +255,9 @@ SlotState BoxGen::emit_op(const Instr& ins) {
     case Op::Tan:
         if (fast_kernels_) return op_tan(in(0));
         return call_core(ins.op, 0, {&in(0)}, in(0).f.maybe_empty);
-    case Op::Atan2: return call_core(ins.op, 0, {&in(0), &in(1)}, in(0).f.maybe_empty || in(1).f.maybe_empty);
+    case Op::Atan2:
+        if (fast_kernels_) return op_atan2(in(0), in(1));
+        return call_core(ins.op, 0, {&in(0), &in(1)}, in(0).f.maybe_empty || in(1).f.maybe_empty);
     case Op::External: return call_external(ins.imm, in(0), in(1), in(2));
     case Op::Lt:
     case Op::Le:

@@ -105,7 +105,8 @@ bool tiers_exactly(const ir::Tape& tape) {
             case ir::Op::Cos:
             case ir::Op::Exp:
             case ir::Op::Tan:
-            case ir::Op::Log: return false;
+            case ir::Op::Log:
+            case ir::Op::Atan2: return false;
             case ir::Op::Pow:
                 if (!integral[ins.in[1]]) return false;
                 break;

@@ -5,7 +5,7 @@
 //
 // Outputs must not depend on when the compile finishes. Where the JIT's enclosures are the
 // interpreter's bit for bit (`tiers_exactly`), an evaluator switches at its first call after the code
-// is ready. Elsewhere (sin, cos, exp, tan, log and pow have inline kernels a few ulps wider than the
+// is ready. Elsewhere (sin, cos, exp, tan, log, pow and atan2 have inline kernels a few ulps wider than the
 // numeric core's) it switches only at a checkpoint of the caller's work (Evaluator::checkpoint: a
 // cover's level boundary) once the work done has passed an estimate of the compile's cost, waiting
 // for the code there if need be: the same point whatever the threads and the timing.

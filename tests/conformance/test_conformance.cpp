@@ -259,8 +259,8 @@ std::string differ_from_first(const std::unique_ptr<ir::Evaluator>* e, int engin
 }
 
 // The interpreter against the JIT and a compiled model built with the numeric core's calls in place of
-// the inline sin, cos, exp, tan, log and pow kernels (FRAC_JIT_EXACT_CALLS=1: the interpreter's bits); then
-// the JIT against a compiled model with the inline kernels (the same generated code).
+// the inline sin, cos, exp, tan, log, pow and atan2 kernels (FRAC_JIT_EXACT_CALLS=1: the interpreter's bits);
+// then the JIT against a compiled model with the inline kernels (the same generated code).
 std::string engines_differ(const ir::Tape& t, const std::vector<Interval>& range, std::uint64_t seed,
                            std::size_t count, const ir::EvalOptions& o = {}) {
     setenv("FRAC_JIT_EXACT_CALLS", "1", 1);

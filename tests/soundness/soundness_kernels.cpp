@@ -1,4 +1,4 @@
-// Soundness and tightness of the JIT's inline interval kernels (sqrt, sin, cos, exp, tan, log, pow;
+// Soundness and tightness of the JIT's inline interval kernels (sqrt, sin, cos, exp, tan, log, pow, atan2;
 // backend/llvm/box_kernels.cpp) against the exact range computed with MPFR: for random intervals of many
 // widths and magnitudes, and the hard cases (near multiples of pi/2, huge arguments, tiny and thin intervals,
 // zeros, infinities, NaN and empty intervals), the JIT's enclosure [L, H] of f over [lo, hi] must satisfy L
@@ -11,7 +11,8 @@
 // Each code variant (the host's default, the portable vector and scalar forms, AVX-512 scalar) gets the
 // same intervals; with the default count every kernel has more than 10^6 checked (interval, range)
 // pairs per variant (the rest are empty or NaN arguments, whose result must be empty, and sin/cos of
-// {inf}). Prints the enclosures' widths against the exact range's (median and worst ratio).
+// {inf}, and for atan2 the origin alone). Prints the enclosures' widths against the exact range's (median and
+// worst ratio).
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/jit.hpp"
 #include "ir/graph.hpp"
@@ -30,6 +31,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 using namespace frac;
@@ -86,6 +88,18 @@ public:
         case 2: return around(signed_magnitude(3, 12));
         case 3: return pick(8) == 0 ? not_an_interval() : uniform(-4, 4);
         default: return around(signed_magnitude(-3, 3));
+        }
+    }
+
+    // A (y, x) box for atan2: intervals of every kind, and boxes on or across the axes, around the
+    // origin, across the cut (y around 0, x < 0), small ones near the axes.
+    std::pair<Interval, Interval> plane_box() {
+        switch (pick(5)) {
+        case 0: return {zeros(), next()};
+        case 1: return {next(), zeros()};
+        case 2: return {zeros(), zeros()};
+        case 3: return {around(signed_magnitude(-40, 5)), around(signed_magnitude(-40, 5))};
+        default: return {next(), next()};
         }
     }
 
@@ -300,20 +314,42 @@ ExactRange tan_range(double lo, double hi) {
     return increasing_range(mpfr_tan, lo, hi);
 }
 
+// Widens e to RD(f(a, b)) and RU(f(a, b)) (MPFR rounds correctly).
+using MpfrFunction2 = int (*)(mpfr_ptr, mpfr_srcptr, mpfr_srcptr, mpfr_rnd_t);
+void extend_by(ExactRange& e, MpfrFunction2 f, double a, double b) {
+    Mpfr av, bv, r;
+    mpfr_set_d(av.v, a, MPFR_RNDN);
+    mpfr_set_d(bv.v, b, MPFR_RNDN);
+    f(r.v, av.v, bv.v, MPFR_RNDD);
+    e.lo = std::min(e.lo, mpfr_get_d(r.v, MPFR_RNDD));
+    f(r.v, av.v, bv.v, MPFR_RNDU);
+    e.hi = std::max(e.hi, mpfr_get_d(r.v, MPFR_RNDU));
+}
+
 // x^y over a box with x > 0: monotone in x for each y and in y for each x, so the extremes are at the
 // corners (MPFR's pow, correctly rounded down and up).
 ExactRange pow_range(Interval x, Interval y) {
     ExactRange e{true, inf, -inf};
-    Mpfr xv, yv, r;
     for (const double a : {x.lo, x.hi})
-        for (const double b : {y.lo, y.hi}) {
-            mpfr_set_d(xv.v, a, MPFR_RNDN);
-            mpfr_set_d(yv.v, b, MPFR_RNDN);
-            mpfr_pow(r.v, xv.v, yv.v, MPFR_RNDD);
-            e.lo = std::min(e.lo, mpfr_get_d(r.v, MPFR_RNDD));
-            mpfr_pow(r.v, xv.v, yv.v, MPFR_RNDU);
-            e.hi = std::max(e.hi, mpfr_get_d(r.v, MPFR_RNDU));
-        }
+        for (const double b : {y.lo, y.hi}) extend_by(e, mpfr_pow, a, b);
+    return e;
+}
+
+// atan2 over a (y, x) box: the angle in (-pi, pi] is continuous on the closed upper half-plane less the
+// origin (values in [0, pi]) and on the open lower one (in (-pi, 0)), and on each part of the box monotone
+// along each axis. So its infimum and supremum over each part are at the part's corners other than the
+// origin, the lower part's top edge taken as y = -0 (its limits: -pi for x < 0) and infinite ends as
+// limits (MPFR's atan2 has C's special values). `defined` false when the box is the origin alone.
+ExactRange atan2_range(Interval y, Interval x) {
+    ExactRange e{true, inf, -inf};
+    auto corners = [&](double y_lo, double y_hi) {
+        for (const double b : {y_lo, y_hi})
+            for (const double a : {x.lo, x.hi})
+                if (b != 0 || a != 0) extend_by(e, mpfr_atan2, b, a);
+    };
+    if (y.hi >= 0) corners(y.lo > 0 ? y.lo : 0.0, y.hi > 0 ? y.hi : 0.0);
+    if (y.lo < 0) corners(y.lo, y.hi < 0 ? y.hi : -0.0);
+    if (e.lo > e.hi) return {false};
     return e;
 }
 
@@ -399,6 +435,93 @@ std::string ratio_summary(std::vector<double> v) {
     return b;
 }
 
+struct Outcome {
+    int passed = 0, failed = 0;
+    std::uint64_t total_checked = 0;
+};
+using Variants = std::vector<std::pair<std::string, jit::JitConfig>>;
+
+// A binary kernel (pow, atan2) on the boxes (boxes[2i], boxes[2i + 1]) in every variant: each result
+// must contain the exact range and the numeric core's enclosure, and an empty argument give an empty
+// result (boxes with no value, the origin for atan2, are not counted). Then the check must be able to fail:
+// the interpreter's enclosures narrowed by one double at each end are rejected.
+void check_binary(const Kernel& k, const std::vector<Interval>& boxes, const std::vector<ExactRange>& exact,
+                  const Variants& variants, Outcome& outcome) {
+    const std::size_t count = exact.size();
+    struct BoxTally {
+        std::uint64_t checked = 0, empty = 0, undefined = 0, violations = 0;
+        std::vector<double> ratios, cell_ratios;
+        std::string first;
+    };
+    auto tally = [&](const std::vector<Interval>& out) {
+        BoxTally t;
+        for (std::size_t i = 0; i < count; ++i) {
+            const Interval a = boxes[2 * i], b = boxes[2 * i + 1], r = out[i];
+            const ExactRange& x = exact[i];
+            std::string why;
+            if (a.is_empty() || b.is_empty()) {
+                ++t.empty;
+                if (!r.is_empty()) why = "an empty argument gives a non-empty result";
+            } else if (!x.defined) {
+                ++t.undefined;
+                continue;
+            } else if (!(r.lo <= x.lo && x.hi <= r.hi)) {
+                why = "the exact range is [" + hex(x.lo) + ", " + hex(x.hi) + "] (outward rounded)";
+            } else if (const double w = x.hi - x.lo; w > 0 && std::isfinite(w)) {
+                t.ratios.push_back((r.hi - r.lo) / w);
+                if (w >= 0x1p-20 * std::max({1.0, std::fabs(x.lo), std::fabs(x.hi)}))
+                    t.cell_ratios.push_back(t.ratios.back());
+            }
+            ++t.checked;
+            if (why.empty()) continue;
+            ++t.violations;
+            if (t.first.empty())
+                t.first = std::string(k.name) + "([" + hex(a.lo) + ", " + hex(a.hi) + "], [" + hex(b.lo) +
+                          ", " + hex(b.hi) + "]) = [" + hex(r.lo) + ", " + hex(r.hi) + "]: " + why;
+        }
+        return t;
+    };
+    ir::Graph g;
+    const ir::Tape tape = ir::build_tape(g, g.op(k.op, g.var(0), g.var(1)), 2);
+    auto interp = interp::make_interpreter(tape);
+    std::vector<Interval> core(count);
+    interp->eval_boxes(boxes.data(), count, core.data());
+    for (const auto& [label, config] : variants) {
+        auto e = jit::make_jit(tape, {}, config);
+        std::vector<Interval> out(count);
+        e->eval_boxes(boxes.data(), count, out.data());
+        const BoxTally t = tally(out);
+        // The engines' cross-checks also rely on the kernel containing the numeric core's enclosure.
+        std::uint64_t misses_core = 0;
+        for (std::size_t i = 0; i < count; ++i) misses_core += !out[i].contains(core[i]);
+        outcome.total_checked += t.checked;
+        std::printf(
+            "%-5s %-15s %llu boxes checked (%llu empty), %llu violations, %llu not containing the core's "
+            "enclosure; width / exact width: %s; exact width >= 2^-20 max(1, |f|): %s\n",
+            k.name, label.c_str(), static_cast<unsigned long long>(t.checked),
+            static_cast<unsigned long long>(t.empty), static_cast<unsigned long long>(t.violations),
+            static_cast<unsigned long long>(misses_core), ratio_summary(t.ratios).c_str(),
+            ratio_summary(t.cell_ratios).c_str());
+        if (t.violations == 0 && misses_core == 0 && t.checked + t.undefined == count &&
+            t.checked > count / 2) {
+            ++outcome.passed;
+        } else {
+            ++outcome.failed;
+            std::printf("FAIL: %s %s: %s\n", k.name, label.c_str(), t.first.c_str());
+        }
+    }
+    std::vector<Interval> narrowed = core;
+    for (Interval& r : narrowed)
+        if (!r.is_empty() && std::isfinite(r.lo) && std::isfinite(r.hi) && r.lo < r.hi)
+            r = {std::nextafter(r.lo, inf), std::nextafter(r.hi, -inf)};
+    if (tally(narrowed).violations > 0) {
+        ++outcome.passed;
+    } else {
+        ++outcome.failed;
+        std::printf("FAIL: %s: the check did not catch narrowed enclosures\n", k.name);
+    }
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -411,16 +534,14 @@ int main(int argc, char** argv) {
     if (const char* v = std::getenv("FRAC_JIT_EXACT_CALLS"); v && std::string(v) == "1")
         std::printf("note: FRAC_JIT_EXACT_CALLS=1, the kernels are the numeric core's calls\n");
     using R = jit::JitConfig::Rounding;
-    std::vector<std::pair<std::string, jit::JitConfig>> variants = {
-        {"default", jit::codegen_config(R::automatic, 0)},
-        {"constrained x4", jit::codegen_config(R::constrained, 4)},
-        {"constrained x1", jit::codegen_config(R::constrained, 1)}};
+    Variants variants = {{"default", jit::codegen_config(R::automatic, 0)},
+                         {"constrained x4", jit::codegen_config(R::constrained, 4)},
+                         {"constrained x1", jit::codegen_config(R::constrained, 1)}};
     if (jit::host_has_avx512()) variants.push_back({"avx512 x1", jit::codegen_config(R::avx512, 1)});
     const Kernel kernels[] = {{"sqrt", ir::Op::Sqrt}, {"sin", ir::Op::Sin}, {"cos", ir::Op::Cos},
                               {"exp", ir::Op::Exp},   {"tan", ir::Op::Tan}, {"log", ir::Op::Log}};
 
-    int passed = 0, failed = 0;
-    std::uint64_t total_checked = 0;
+    Outcome outcome;
     std::uint64_t seed = 20261202;
     for (const Kernel& k : kernels) {
         IntervalMaker maker(seed++);
@@ -442,7 +563,7 @@ int main(int argc, char** argv) {
             std::vector<Interval> out(in.size());
             e->eval_boxes(in.data(), in.size(), out.data());
             const Tally t = check(k, in, out, exact);
-            total_checked += t.checked;
+            outcome.total_checked += t.checked;
             std::printf("%-4s %-15s %llu pairs, %llu checked, %llu correctly rounded, %llu violations; "
                         "width / exact width (kernel domain): %s; exact width >= 2^-20 max(1, |f|): %s\n",
                         k.name, label.c_str(), static_cast<unsigned long long>(t.pairs),
@@ -453,9 +574,9 @@ int main(int argc, char** argv) {
             // sqrt is exact: directed rounding gives the correctly rounded range on every pair with a value.
             const bool tight = k.op != ir::Op::Sqrt || t.exact + t.outside_domain == t.checked;
             if (ok && tight) {
-                ++passed;
+                ++outcome.passed;
             } else {
-                ++failed;
+                ++outcome.failed;
                 std::printf("FAIL: %s %s: %s\n", k.name, label.c_str(),
                             t.first.empty() ? "sqrt not correctly rounded" : t.first.c_str());
             }
@@ -471,15 +592,14 @@ int main(int argc, char** argv) {
                     r = {std::nextafter(r.lo, inf), std::nextafter(r.hi, -inf)};
             const Tally t = check(k, in, narrowed, exact);
             if (t.violations > 0) {
-                ++passed;
+                ++outcome.passed;
             } else {
-                ++failed;
+                ++outcome.failed;
                 std::printf("FAIL: %s: the check did not catch narrowed enclosures\n", k.name);
             }
         }
     }
-    // pow(x, y): positive bases, exponents of every kind; the result over each box must contain the
-    // exact range, and an empty exponent give an empty result.
+    // pow(x, y): positive bases, exponents of every kind.
     {
         IntervalMaker maker(seed++);
         std::vector<Interval> boxes(2 * pairs);
@@ -489,69 +609,21 @@ int main(int argc, char** argv) {
             boxes[2 * i + 1] = maker.exponent();
             if (!boxes[2 * i + 1].is_empty()) exact[i] = pow_range(boxes[2 * i], boxes[2 * i + 1]);
         }
-        ir::Graph g;
-        const ir::Tape tape = ir::build_tape(g, g.op(ir::Op::Pow, g.var(0), g.var(1)), 2);
-        struct PowTally {
-            std::uint64_t checked = 0, violations = 0;
-            std::vector<double> ratios;
-            std::string first;
-        };
-        auto tally = [&](const std::vector<Interval>& out) {
-            PowTally t;
-            for (std::uint64_t i = 0; i < pairs; ++i) {
-                const Interval x = boxes[2 * i], y = boxes[2 * i + 1], r = out[i];
-                std::string why;
-                if (y.is_empty()) {
-                    if (!r.is_empty()) why = "an empty exponent gives a non-empty result";
-                } else if (!(r.lo <= exact[i].lo && exact[i].hi <= r.hi)) {
-                    why = "the exact range is [" + hex(exact[i].lo) + ", " + hex(exact[i].hi) + "]";
-                } else {
-                    const double w = exact[i].hi - exact[i].lo;
-                    if (w >= 0x1p-20 * std::max({1.0, std::fabs(exact[i].lo), std::fabs(exact[i].hi)}) &&
-                        std::isfinite(w))
-                        t.ratios.push_back((r.hi - r.lo) / w);
-                }
-                ++t.checked;
-                if (why.empty()) continue;
-                ++t.violations;
-                if (t.first.empty())
-                    t.first = "pow([" + hex(x.lo) + ", " + hex(x.hi) + "], [" + hex(y.lo) + ", " + hex(y.hi) +
-                              "]) = [" + hex(r.lo) + ", " + hex(r.hi) + "]: " + why;
-            }
-            return t;
-        };
-        for (const auto& [label, config] : variants) {
-            auto e = jit::make_jit(tape, {}, config);
-            std::vector<Interval> out(pairs);
-            e->eval_boxes(boxes.data(), pairs, out.data());
-            const PowTally t = tally(out);
-            total_checked += t.checked;
-            std::printf("pow  %-15s %llu boxes checked, %llu violations; width / exact width (exact width >= "
-                        "2^-20 max(1, |f|)): %s\n",
-                        label.c_str(), static_cast<unsigned long long>(t.checked),
-                        static_cast<unsigned long long>(t.violations), ratio_summary(t.ratios).c_str());
-            if (t.violations == 0 && t.checked == pairs) {
-                ++passed;
-            } else {
-                ++failed;
-                std::printf("FAIL: pow %s: %s\n", label.c_str(), t.first.c_str());
-            }
+        check_binary({"pow", ir::Op::Pow}, boxes, exact, variants, outcome);
+    }
+    // atan2(y, x): boxes of every kind, on and across the axes, around the origin, across the cut.
+    {
+        IntervalMaker maker(seed++);
+        std::vector<Interval> boxes(2 * pairs);
+        std::vector<ExactRange> exact(pairs);
+        for (std::uint64_t i = 0; i < pairs; ++i) {
+            std::tie(boxes[2 * i], boxes[2 * i + 1]) = maker.plane_box();
+            if (!boxes[2 * i].is_empty() && !boxes[2 * i + 1].is_empty())
+                exact[i] = atan2_range(boxes[2 * i], boxes[2 * i + 1]);
         }
-        // The check must be able to fail: the interpreter's enclosures narrowed by one double at each end.
-        auto interp = interp::make_interpreter(tape);
-        std::vector<Interval> narrowed(pairs);
-        interp->eval_boxes(boxes.data(), pairs, narrowed.data());
-        for (Interval& r : narrowed)
-            if (!r.is_empty() && std::isfinite(r.lo) && std::isfinite(r.hi) && r.lo < r.hi)
-                r = {std::nextafter(r.lo, inf), std::nextafter(r.hi, -inf)};
-        if (tally(narrowed).violations > 0) {
-            ++passed;
-        } else {
-            ++failed;
-            std::printf("FAIL: pow: the check did not catch narrowed enclosures\n");
-        }
+        check_binary({"atan2", ir::Op::Atan2}, boxes, exact, variants, outcome);
     }
     std::printf("%llu (interval, kernel, variant) checks\n%d passed, %d failed\n",
-                static_cast<unsigned long long>(total_checked), passed, failed);
-    return failed ? 1 : 0;
+                static_cast<unsigned long long>(outcome.total_checked), outcome.passed, outcome.failed);
+    return outcome.failed ? 1 : 0;
 }

@@ -32,7 +32,7 @@ inline std::string describe(const jit::JitConfig& c) {
 }
 
 // Whether the tape has an operation whose inline kernel encloses more loosely than the numeric core
-// (sin, cos, exp, tan, log, pow with an exponent that may not be an integer: a few ulps,
+// (sin, cos, exp, tan, log, atan2, pow with an exponent that may not be an integer: a few ulps,
 // backend/llvm/box_kernels.cpp); sqrt's kernel is exact. The tiered engine relies on the others
 // agreeing bit for bit, which cross_check verifies on them with the JIT's own kernels.
 inline bool has_loose_kernel(const ir::Tape& tape) {

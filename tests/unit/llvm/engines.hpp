@@ -49,7 +49,7 @@ struct TieredEngine {
         return jit::tiers_exactly(t) ? jit::make_tiered(t, o, {}) : jit::make_jit(t, o);
     }
 };
-// The JIT with the numeric core's calls in place of the inline sin, cos, exp, tan, log and pow kernels
+// The JIT with the numeric core's calls in place of the inline sin, cos, exp, tan, log, pow and atan2 kernels
 // (FRAC_JIT_EXACT_CALLS=1): the interpreter's bits, for the checks that compare engines bit for bit.
 inline std::unique_ptr<ir::Evaluator> make_jit_exact_calls(const ir::Tape& t, const ir::EvalOptions& o = {},
                                                            const jit::JitConfig& config = {}) {

@@ -31,7 +31,7 @@ TEST_CASE("which tapes the JIT computes bit for bit as the interpreter", "[llvm]
     // Exact operations, and powers with an integer exponent (the JIT's pow calls the core's powi).
     CHECK(jit::tiers_exactly(only_tape(compile(scene))));
     CHECK(jit::tiers_exactly(only_tape(compile("shape s(x, y) = y - sum(i in 0.., dz(3^i * x) / 3^i);"))));
-    CHECK(jit::tiers_exactly(only_tape(compile("shape s(x, y) = atan2(y, x) + x^3;"))));
+    CHECK(jit::tiers_exactly(only_tape(compile("shape s(x, y) = y - x^3;"))));
     CHECK(jit::tiers_exactly(
         only_tape(compile("shape s(x, y) = y - sum(i in 0.., dz(3^(2 * i + 1) * x) / 3^(i + 1));"))));
     // Every shape of the solids (the sponge's 3^(17 + k) included).
@@ -44,7 +44,8 @@ TEST_CASE("which tapes the JIT computes bit for bit as the interpreter", "[llvm]
     for (const char* loose :
          {"shape s(x, y) = sin(x) - y;", "shape s(x, y) = cos(x) - y;", "shape s(x, y) = exp(x) - y;",
           "shape s(x, y) = tan(x) - y;", "shape s(x, y) = log(x) - y;", "shape s(x, y) = x^y;",
-          "shape s(x, y) = x^0.5 - y;", "shape s(x, y) = y - sum(i in 0.., dz(2^(i / 2) * x) / 2^i);"}) {
+          "shape s(x, y) = x^0.5 - y;", "shape s(x, y) = atan2(y, x) + x^3;",
+          "shape s(x, y) = y - sum(i in 0.., dz(2^(i / 2) * x) / 2^i);"}) {
         INFO(loose);
         const Model m = compile(loose);
         CHECK_FALSE(jit::tiers_exactly(only_tape(m)));
