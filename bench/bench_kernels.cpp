@@ -1,6 +1,6 @@
-// The JIT's inline interval kernels (sqrt, sin, cos, exp, tan, log: backend/llvm/box_kernels.cpp) against the
-// calls into the numeric core they replace (FRAC_JIT_EXACT_CALLS=1 at compile time) and against the
-// interpreter, every variant in this one run, repetitions interleaved, medians:
+// The JIT's inline interval kernels (sqrt, sin, cos, exp, tan, log, atan2: backend/llvm/box_kernels.cpp)
+// against the calls into the numeric core they replace (FRAC_JIT_EXACT_CALLS=1 at compile time) and against
+// the interpreter, every variant in this one run, repetitions interleaved, medians:
 //  1. octree covers (one thread) of the scenes of bench/kernel_scenes.frac: a gyroid sheet in a ball
 //     (sin, cos, sqrt) and spheres and boxes in CSG (sqrt); the covers of the variants compared cell by cell;
 //  2. each kernel alone on random intervals: nanoseconds per evaluation, and the width of its enclosure
@@ -99,31 +99,34 @@ std::vector<ir::Interval> cell_like(std::size_t n, std::uint64_t seed, bool posi
     return v;
 }
 
-void kernel(const char* name, ir::Op op, int reps, bool positive = false) {
+// `arity` 2: boxes of two such intervals (atan2's (y, x)).
+void kernel(const char* name, ir::Op op, int reps, bool positive = false, int arity = 1) {
     ir::Graph g;
-    const ir::Tape t = ir::build_tape(g, g.op(op, g.var(0)), 1);
-    const std::vector<ir::Interval> in = cell_like(1 << 20, 42, positive);
+    const ir::Tape t = arity == 2 ? ir::build_tape(g, g.op(op, g.var(0), g.var(1)), 2)
+                                  : ir::build_tape(g, g.op(op, g.var(0)), 1);
+    const std::size_t count = 1 << 20, chunk = 4096;
+    const std::vector<ir::Interval> in = cell_like(count * static_cast<std::size_t>(arity), 42, positive);
     auto vs = variants(t);
-    std::vector<std::vector<ir::Interval>> out(vs.size(), std::vector<ir::Interval>(in.size()));
+    std::vector<std::vector<ir::Interval>> out(vs.size(), std::vector<ir::Interval>(count));
     for (int r = 0; r < reps; ++r)
         for (std::size_t k = 0; k < vs.size(); ++k) {
             const auto t0 = Clock::now();
-            for (std::size_t i = 0; i < in.size(); i += 4096)
-                vs[k].e->eval_boxes(in.data() + i, std::min<std::size_t>(4096, in.size() - i),
-                                    out[k].data() + i);
+            for (std::size_t i = 0; i < count; i += chunk)
+                vs[k].e->eval_boxes(in.data() + i * static_cast<std::size_t>(arity),
+                                    std::min(chunk, count - i), out[k].data() + i);
             vs[k].seconds.push_back(seconds_since(t0));
         }
     // Tightness: width against the numeric core's correctly rounded enclosure of the exact range.
     std::vector<double> ratio;
     bool contains = true;
-    for (std::size_t i = 0; i < in.size(); ++i) {
+    for (std::size_t i = 0; i < count; ++i) {
         const ir::Interval exact = out[0][i], fast = out[2][i];
         contains = contains && fast.contains(exact);
         const double width = exact.hi - exact.lo; // finite and positive (tan over a pole is all of R)
         if (width > 0 && std::isfinite(width)) ratio.push_back((fast.hi - fast.lo) / width);
     }
     std::sort(ratio.begin(), ratio.end());
-    const double n = double(in.size());
+    const double n = double(count);
     fmt::print("{:<5} {:>10.2f} {:>10.2f} {:>10.2f} {:>9.2f}x {:>9.2f}x   {:.12f} {:.12f}  {}\n", name,
                1e9 * median(vs[0].seconds) / n, 1e9 * median(vs[1].seconds) / n,
                1e9 * median(vs[2].seconds) / n, median(vs[0].seconds) / median(vs[2].seconds),
@@ -154,7 +157,8 @@ int main(int argc, char** argv) {
 
     fmt::print(
         "\nEach kernel on 2^20 random intervals of widths 2^-12 .. 1 in [-8, 8] (log: in (0, 16]; ns per "
-        "evaluation, median of {});\nwidth / width of the correctly rounded range: median and worst\n",
+        "evaluation, median of {}; atan2: boxes of two);\nwidth / width of the correctly rounded range: "
+        "median and worst\n",
         reps);
     fmt::print("{:<5} {:>10} {:>10} {:>10} {:>10} {:>10}   {:<14} {:<14}\n", "op", "interp", "calls",
                "inline", "vs interp", "vs calls", "median ratio", "worst ratio");
@@ -164,5 +168,6 @@ int main(int argc, char** argv) {
     kernel("exp", ir::Op::Exp, reps);
     kernel("tan", ir::Op::Tan, reps);
     kernel("log", ir::Op::Log, reps, true);
+    kernel("atan2", ir::Op::Atan2, reps, false, 2);
     return 0;
 }
