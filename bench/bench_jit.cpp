@@ -6,6 +6,7 @@
 //   bench_jit [depth=10] [large_depth=12] [json=bench_jit.json] [depth_3d=6]
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/jit.hpp"
+#include "backend/llvm/tiered.hpp"
 #include "bench/bench_common.hpp"
 #include "bench/carpet_handwritten.hpp"
 #include "driver/pipeline.hpp"
@@ -292,7 +293,11 @@ int main(int argc, char** argv) {
         const bool agree = ci.boundary == cj.boundary && ci.terms == cj.terms && ci.boxes == cj.boxes;
         fmt::print("{:<20} {:>5} {:>11} {:>11.2f} {:>10.3f} {:>10.3f} {:>12.0f} {:>8.2f}x{}\n", s.name, d,
                    cj.boxes, double(cj.terms) / double(cj.boxes), ci.seconds, cj.seconds,
-                   cj.boxes / cj.seconds, ci.seconds / cj.seconds, agree ? "" : "  COVERS DIFFER");
+                   cj.boxes / cj.seconds, ci.seconds / cj.seconds,
+                   agree ? ""
+                   : jit::tiers_exactly(s.tape)
+                       ? "  COVERS DIFFER"
+                       : "  (inline kernels a few ulps wider: cells or terms differ)");
         json += fmt::format(
             "    {{\"shape\": \"{}\", \"depth\": {}, \"boxes\": {}, \"series_terms\": {}, "
             "\"interp_seconds\": {:.6f}, \"jit_seconds\": {:.6f}, \"speedup\": {:.3f}, \"agree\": {}}}{}\n",

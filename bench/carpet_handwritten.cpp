@@ -4,6 +4,7 @@
 
 #include "ir/graph.hpp"
 #include "ir/series_tail.hpp"
+#include "numeric/interval_kernels.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -14,23 +15,12 @@ namespace {
 
 using num::Interval;
 
-// Hides a value from the optimiser so -((-x) - y) is not folded into x + y (as in the numeric core).
-inline double opaque(double x) {
-    asm("" : "+x"(x));
-    return x;
-}
-inline double add_down(double x, double y) {
-    return -opaque(opaque(-x) - y);
-}
-inline double sub_down(double x, double y) {
-    return -opaque(opaque(-x) + y);
-}
-inline double mul_down(double x, double y) {
-    return -opaque(opaque(-x) * y);
-}
-inline double div_down(double x, double y) {
-    return -opaque(opaque(-x) / y);
-}
+// The numeric core's rounded-down operations (-RU(-x op y)), as the core and the interpreters use them.
+using num::kernels::add_down;
+using num::kernels::div_down;
+using num::kernels::mul_down;
+using num::kernels::sub_down;
+
 inline double mn(double a, double b) {
     return b < a ? b : a;
 }
