@@ -3,9 +3,9 @@
 // others with them, so the inlined and the called forms are one code.
 //
 // Include only from files compiled with -frounding-math -fno-fast-math (the libraries of numeric/,
-// ir/ and backend/interp/): the upper bounds are plain expressions that must round upward at run
-// time, which the optimiser may not assume of code compiled without it. They require upward
-// rounding (num::UpwardRounding) like the rest of interval.hpp's operations.
+// ir/ and backend/interp/, bench/carpet_handwritten.cpp): the upper bounds are plain expressions that must
+// round upward at run time, which the optimiser may not assume of code compiled without it. They require
+// upward rounding (num::UpwardRounding) like the rest of interval.hpp's operations.
 #pragma once
 
 #include "numeric/interval.hpp"

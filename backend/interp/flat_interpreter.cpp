@@ -77,6 +77,12 @@ struct FlatCode {
 
     Slot constant_count() const { return static_cast<Slot>(constants.size()); }
     Slot first_input() const { return constant_count(); }
+    // Notes what instruction k, once written, means for pushes: a partial operation, a choice
+    // (instructions are noted in order).
+    void note_instruction(std::size_t k) {
+        if (is_partial(code[k].op)) partial[partial_noted++] = static_cast<std::uint32_t>(k);
+        has_choices |= ir::is_choice(code[k].op);
+    }
     Slot first_result() const { return constant_count() + static_cast<Slot>(inputs); }
 
     static std::shared_ptr<FlatCode> make(int inputs, std::size_t constants, std::size_t instructions,
@@ -103,6 +109,7 @@ struct FlatCode {
     }
 
 private:
+    std::size_t partial_noted = 0;
     std::unique_ptr<std::byte[]> storage_;
 };
 
@@ -212,7 +219,7 @@ public:
     double eval_point(const double* coords) override {
         ++stats.calls;
         double* r = thread_file().points_of(*code_);
-        load(r, coords);
+        std::copy_n(coords, code_->inputs, r + code_->first_input());
         for (const FlatInstr& ins : code_->code) {
             double args[3];
             for (int i = 0; i < ir::arity(ins.op); ++i) args[i] = r[ins.in[static_cast<std::size_t>(i)]];
@@ -323,11 +330,6 @@ private:
         for (int i = 0; i < ir::arity(ins.op); ++i)
             args[i] = r[ins.in[static_cast<std::size_t>(i)] * stride + lane];
         return ir::apply_interval(ins.op, args, 0);
-    }
-
-    template <class V>
-    void load(V* r, const V* inputs) const {
-        std::copy_n(inputs, code_->inputs, r + code_->first_input());
     }
 
     static bool defined(const FlatInstr& ins, const BoxValues& r) {
@@ -469,7 +471,6 @@ private:
             return final_slot[n];
         };
         Slot next = pruned->first_result();
-        std::size_t partial_at = 0;
         for (std::size_t k = 0; k < count; ++k) {
             FlatInstr& n = pruned->code[k];
             n = file.reversed[count - 1 - k];
@@ -477,8 +478,7 @@ private:
                 n.in[static_cast<std::size_t>(a)] = slot_of(n.in[static_cast<std::size_t>(a)]);
             final_slot[n.out] = next;
             n.out = next++;
-            if (is_partial(n.op)) pruned->partial[partial_at++] = static_cast<std::uint32_t>(k);
-            pruned->has_choices |= ir::is_choice(n.op);
+            pruned->note_instruction(k);
         }
         pruned->result = slot_of(result);
         ++specialize_stats.pushes;
@@ -529,7 +529,6 @@ std::unique_ptr<ir::Evaluator> make_flat_interpreter(const ir::Tape& tape, const
         return renumber[s];
     };
     Slot next = code->first_result();
-    std::size_t partial_at = 0;
     for (std::size_t k = 0; k < instructions.size(); ++k) {
         const ir::Instr& ins = instructions[k];
         FlatInstr n = flat_instr(ins.op, ins.out, ins.in);
@@ -537,9 +536,8 @@ std::unique_ptr<ir::Evaluator> make_flat_interpreter(const ir::Tape& tape, const
             n.in[static_cast<std::size_t>(i)] = slot(ins.in[static_cast<std::size_t>(i)]);
         if (ins.op == Op::PowI) n.in[1] = static_cast<Slot>(static_cast<std::int32_t>(ins.imm));
         n.out = renumber[ins.out] = next++;
-        if (is_partial(ins.op)) code->partial[partial_at++] = static_cast<std::uint32_t>(k);
-        code->has_choices |= ir::is_choice(ins.op);
         code->code[k] = n;
+        code->note_instruction(k);
     }
     code->result = slot(tape.result);
     return std::make_unique<FlatInterpreter>(std::move(code), options);
