@@ -4,6 +4,8 @@
 //    models only: it takes minutes on the big ones), with pruning by default (every cell with
 //    children asks; the engine's rule decides) and with pruning only 5 or 3 or more levels above
 //    the depth (5: the old rule; without the JIT on big models its cover is the reference);
+//  - the default with the flat interpreter's boxes side by side on the scalar kernels, lane by lane
+//    (the vector kernels are the default where the CPU has AVX2);
 //  - the tape interpreter (the reference, instruction by instruction) with pruning, which flat tapes
 //    such as these ran on before the flat interpreter;
 //  - the JIT with pruning (its compile time apart and in the wall time); the JIT only up to 1000
@@ -14,8 +16,11 @@
 // interpreter, the cells, the prune requests, the pruned functions made and the mean instructions
 // per evaluation. Writes the models (for `frac render`) and JSON.
 //
-//   bench_large [depth=10] [json=bench_large.json] [model_dir=.] [sizes=1000,3000,7000] [jit=1] [quick]
-// `quick`: the default pruned interpreter alone (no reference cover, no comparison): for profiling.
+//   bench_large [depth=10] [json=bench_large.json] [model_dir=.] [sizes=1000,3000,7000] [jit=1]
+//               [quick|pushes]
+// `quick`: the default pruned interpreter alone (no reference cover, no comparison): for profiling;
+// `pushes`: the push costs alone (below; printed unless `quick`).
+#include "backend/interp/flat_interpreter.hpp"
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/jit.hpp"
 #include "bench/bench_common.hpp"
@@ -27,6 +32,7 @@
 #include <fmt/format.h>
 #include <fstream>
 #include <iostream>
+#include <random>
 #include <sstream>
 
 using namespace frac;
@@ -42,6 +48,7 @@ struct Variant {
     bool prune = true;
     int min_remaining = rt::default_prune_min_remaining;
     bool tape_interpreter = false; // the instruction-by-instruction interpreter, not the flat one
+    bool scalar_lanes = false;     // the flat interpreter's boxes side by side on the scalar kernels
 };
 
 // CPU time of this thread: the machine is shared, and a cover on one thread is this thread's work.
@@ -60,6 +67,7 @@ struct Run {
 Run cover(const ir::Tape& tape, const std::vector<ir::Interval>& box, int depth, const Variant& v) {
     ir::EvalOptions eo;
     eo.prune = v.prune;
+    interp::use_vector_lanes(!v.scalar_lanes);
     Run run;
     const auto t0 = Clock::now();
     auto e = v.jit                ? jit::make_jit(tape, eo)
@@ -76,7 +84,76 @@ Run cover(const ir::Tape& tape, const std::vector<ir::Interval>& box, int depth,
     run.cover_cpu_s = thread_cpu_s() - cpu0;
     run.cover_s = run.result.seconds;
     run.spec = e->specialize_stats;
+    interp::use_vector_lanes(true);
     return run;
+}
+
+// The constants of the interpreter's push rule (backend/interp/interpreter.hpp), measured on the model's
+// own tapes: descents from the root through undecided cells, each level's tape pushed from its parent's
+// as a cover does; per level, the best of `repeats` timings of evaluating a cell's 4 children side by
+// side and of the push of one undecided child. Prints the push in evaluations of one box with the
+// parent's tape (the rule's push_build_evaluations) and the time per instruction of both.
+void push_costs(const ir::Tape& tape, const std::vector<ir::Interval>& root, int depth) {
+    constexpr int descents = 12, repeats = 15;
+    struct Level {
+        double instructions = 0, eval_ns = 0, push_ns = 0;
+        int samples = 0;
+    };
+    std::vector<Level> levels(static_cast<std::size_t>(depth));
+    std::mt19937 rng(7);
+    ir::EvalOptions eo;
+    for (int descent = 0; descent < descents; ++descent) {
+        std::shared_ptr<ir::Evaluator> e = interp::make_interpreter(tape, eo);
+        std::vector<ir::Interval> box = root;
+        for (int level = 0; level < depth; ++level) {
+            std::vector<ir::Interval> children;
+            for (int c = 0; c < 4; ++c) {
+                const ir::Interval x = box[0], y = box[1];
+                const double mx = 0.5 * (x.lo + x.hi), my = 0.5 * (y.lo + y.hi);
+                children.push_back(c % 2 ? ir::Interval{mx, x.hi} : ir::Interval{x.lo, mx});
+                children.push_back(c / 2 ? ir::Interval{my, y.hi} : ir::Interval{y.lo, my});
+            }
+            ir::Interval out[4];
+            double best_eval = 1e300, best_push = 1e300;
+            std::vector<int> undecided;
+            std::shared_ptr<ir::Evaluator> pushed;
+            for (int r = 0; r < repeats; ++r) {
+                auto t0 = Clock::now();
+                e->eval_boxes(children.data(), 4, out);
+                best_eval = std::min(best_eval, seconds_since(t0));
+                if (r == 0)
+                    for (int c = 0; c < 4; ++c)
+                        if (out[c].lo <= 0 && out[c].hi >= 0) undecided.push_back(c);
+                if (undecided.empty()) break;
+                const int c = undecided[static_cast<std::size_t>(descent) % undecided.size()];
+                t0 = Clock::now();
+                pushed = e->specialize_after_eval(static_cast<std::size_t>(c), &children[2 * c], 1e12);
+                best_push = std::min(best_push, seconds_since(t0));
+            }
+            if (undecided.empty()) break;
+            Level& l = levels[static_cast<std::size_t>(level)];
+            l.instructions += static_cast<double>(e->instruction_count());
+            l.eval_ns += 1e9 * best_eval / 4;
+            l.push_ns += 1e9 * best_push;
+            ++l.samples;
+            const int c = undecided[static_cast<std::size_t>(descent) % undecided.size()];
+            box = {children[2 * c], children[2 * c + 1]};
+            if (pushed) e = pushed;
+        }
+    }
+    fmt::print(
+        "  push costs ({} descents, best of {}; means per level):\n  {:>5} {:>12} {:>12} {:>12} {:>12} "
+        "{:>12} {:>14}\n",
+        descents, repeats, "level", "instructions", "eval ns/box", "ns/instr/box", "push ns", "ns/instr",
+        "push in evals");
+    for (std::size_t k = 0; k < levels.size(); ++k) {
+        const Level& l = levels[k];
+        if (l.samples == 0) continue;
+        const double n = l.instructions / l.samples, eval = l.eval_ns / l.samples,
+                     push = l.push_ns / l.samples;
+        fmt::print("  {:>5} {:>12.0f} {:>12.0f} {:>12.2f} {:>12.0f} {:>12.2f} {:>14.1f}\n", k, n, eval,
+                   eval / n, push, push / n, push / eval);
+    }
 }
 
 std::vector<int> parse_sizes(const std::string& s) {
@@ -94,7 +171,8 @@ int main(int argc, char** argv) {
     const std::string model_dir = argc > 3 ? argv[3] : ".";
     const std::vector<int> sizes = parse_sizes(argc > 4 ? argv[4] : "1000,3000,7000");
     const bool with_jit = argc > 5 ? std::atoi(argv[5]) != 0 : true;
-    const bool quick = argc > 6 && std::string(argv[6]) == "quick";
+    const std::string mode = argc > 6 ? argv[6] : "";
+    const bool quick = mode == "quick" || mode == "pushes";
     std::string why;
     if (with_jit && !jit::jit_available(&why)) {
         std::cerr << "bench_large: the JIT is not available: " << why << "\n";
@@ -112,6 +190,8 @@ int main(int argc, char** argv) {
     const Variant pruned_3{"interp, pruning (>= 3 levels left)", false, true, 3};
     Variant pruned_tape{"tape interpreter, pruning (default)", false, true};
     pruned_tape.tape_interpreter = true;
+    Variant pruned_scalar{"interp, pruning, scalar lanes", false, true};
+    pruned_scalar.scalar_lanes = true;
     std::string json = "[";
     for (int clauses : sizes) {
         const bench::LargeModel model = bench::large_model(clauses);
@@ -132,6 +212,8 @@ int main(int argc, char** argv) {
             "\n{} ({} clauses, {} bytes of source): frontend {:.0f} ms, tape {:.0f} ms, {} instructions\n",
             model.name, model.clauses, model.source.size(), 1e3 * front_s, 1e3 * tape_s,
             tape.instruction_count());
+        if (mode != "quick") push_costs(tape, s.box, depth);
+        if (mode == "pushes") continue;
         fmt::print("  {:<36} {:>10} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>9}  {}\n", "variant",
                    "ns/eval", "cpu ns/ev", "compile s", "cover s", "wall s", "evals", "pruned", "functions",
                    "cover");
@@ -147,6 +229,7 @@ int main(int argc, char** argv) {
         if (!late_is_reference && !quick) variants.push_back(pruned_late);
         if (!quick) variants.push_back(pruned_3);
         if (!quick) variants.push_back(pruned_tape);
+        if (!quick) variants.push_back(pruned_scalar);
         if (jit_here) variants.push_back({"jit, pruning", true, true});
         std::vector<Run> runs;
         for (const Variant& v : variants) {
@@ -188,6 +271,10 @@ int main(int argc, char** argv) {
                 if (variants[k].tape_interpreter)
                     fmt::print(
                         "  flat interpreter against the tape interpreter (cpu time, both pruning): {:.2f}x\n",
+                        runs[k].cover_cpu_s / now.cover_cpu_s);
+                else if (variants[k].scalar_lanes)
+                    fmt::print(
+                        "  vector kernels against the scalar kernels (cpu time, both pruning): {:.2f}x\n",
                         runs[k].cover_cpu_s / now.cover_cpu_s);
         }
         fmt::print(

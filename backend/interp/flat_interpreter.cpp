@@ -1,6 +1,7 @@
 #include "backend/interp/flat_interpreter.hpp"
 
 #include "backend/interp/interpreter.hpp"
+#include "backend/interp/lane_kernels.hpp"
 #include "ir/semantics.hpp"
 #include "ir/specialize.hpp"
 #include "numeric/interval_kernels.hpp"
@@ -94,7 +95,7 @@ struct FlatCode {
         // Widest alignment first: intervals and doubles, then instructions and indices (4 bytes).
         const std::size_t bytes = constants * (sizeof(Interval) + sizeof(double)) +
                                   instructions * sizeof(FlatInstr) + partial * sizeof(std::uint32_t);
-        c->storage_ = std::make_unique<std::byte[]>(bytes);
+        c->storage_ = std::make_unique_for_overwrite<std::byte[]>(bytes); // every byte is written
         std::byte* p = c->storage_.get();
         const auto take = [&p]<class T>(std::size_t n, T*) {
             std::span<T> s(reinterpret_cast<T*>(p), n);
@@ -124,28 +125,38 @@ inline constexpr std::uint32_t constant_tag = 1u << 31, input_tag = 1u << 30, no
 // their operations are independent (a cover's sibling cells share their parent's tape).
 inline constexpr std::size_t lanes = 4;
 
-// A register file: slot s of lane j at values[s * stride + j]; `code` names the tape whose constants
-// it holds.
+// A register file of `L` boxes side by side: slot s holds its L lower bounds, then its L upper bounds,
+// at values[s * 2L ...] (one cache line for four boxes, vectors of bounds for lane_kernels); `code` names
+// the tape whose constants it holds.
 struct RegisterFile {
+    struct alignas(64) Line {
+        double v[8];
+    };
     std::uint64_t code = 0;
-    std::vector<Interval> values;
+    std::vector<Line> lines;
 
-    Interval* of(const FlatCode& c, std::size_t stride) {
+    double* of(const FlatCode& c, std::size_t L) {
         if (code != c.id) {
-            if (values.size() < c.num_slots * stride) values.resize(c.num_slots * stride);
-            for (std::size_t s = 0; s < c.constants.size(); ++s)
-                std::fill_n(values.begin() + static_cast<std::ptrdiff_t>(s * stride), stride, c.constants[s]);
+            const std::size_t doubles = c.num_slots * 2 * L;
+            if (lines.size() * 8 < doubles) lines.resize((doubles + 7) / 8);
+            double* r = lines.data()->v;
+            for (std::size_t s = 0; s < c.constants.size(); ++s) {
+                std::fill_n(r + s * 2 * L, L, c.constants[s].lo);
+                std::fill_n(r + s * 2 * L + L, L, c.constants[s].hi);
+            }
             code = c.id;
         }
-        return values.data();
+        return lines.data()->v;
     }
 };
 
 // The values of one box of the last evaluation: its lane of a register file.
 struct BoxValues {
-    const Interval* base;
-    std::size_t stride, lane;
-    Interval operator[](Slot s) const { return base[s * stride + lane]; }
+    const double* base;
+    std::size_t lanes, lane;
+    Interval operator[](Slot s) const {
+        return {base[s * 2 * lanes + lane], base[s * 2 * lanes + lanes + lane]};
+    }
 };
 
 // A thread's registers and push scratch, shared by every flat evaluator that runs on the thread.
@@ -199,6 +210,120 @@ ThreadFile& thread_file() {
     thread_local ThreadFile file;
     return file;
 }
+
+// Instruction `ins` on each of the L boxes of register file r, by the reference's operations (powi and
+// the operations without a handler). Out of line: compiled for any CPU, called from every loop.
+[[gnu::noinline]] void apply_by_lane(const FlatInstr& ins, double* r, std::size_t L) {
+    for (std::size_t j = 0; j < L; ++j) {
+        const BoxValues v{r, L, j};
+        Interval args[3];
+        for (int i = 0; i < ir::arity(ins.op); ++i) args[i] = v[ins.in[static_cast<std::size_t>(i)]];
+        const Interval out =
+            ins.op == Op::PowI ? num::powi(args[0], immediate(ins)) : ir::apply_interval(ins.op, args, 0);
+        r[ins.out * 2 * L + j] = out.lo;
+        r[ins.out * 2 * L + L + j] = out.hi;
+    }
+}
+
+std::atomic<bool> vector_lanes_wanted{true};
+
+// Whether four boxes run on lane_kernels: asked for, and this CPU has them.
+bool vector_lanes() {
+#ifdef FRAC_LANE_KERNELS
+    static const bool supported = lane_kernels::supported();
+    return supported && vector_lanes_wanted.load(std::memory_order_relaxed);
+#else
+    return false;
+#endif
+}
+
+// The operations with a handler of their own and a kernel (dispatch's labels).
+#define FRAC_LANE_OPERATIONS(UNARY, BINARY)                                                                  \
+    BINARY(add) BINARY(sub) BINARY(mul) UNARY(neg) UNARY(sqr) UNARY(sqrt) UNARY(abs) BINARY(min) BINARY(max)
+
+// The scalar kernels, lane by lane.
+template <std::size_t L>
+struct ScalarLanes {
+    static constexpr std::size_t lanes = L;
+    using Value = std::array<Interval, L>;
+    static Value load(const double* r, Slot s) {
+        Value v;
+        for (std::size_t j = 0; j < L; ++j) v[j] = {r[s * 2 * L + j], r[s * 2 * L + L + j]};
+        return v;
+    }
+    static void store(double* r, Slot s, const Value& v) {
+        for (std::size_t j = 0; j < L; ++j) {
+            r[s * 2 * L + j] = v[j].lo;
+            r[s * 2 * L + L + j] = v[j].hi;
+        }
+    }
+#define FRAC_UNARY(name)                                                                                     \
+    static Value name(const Value& a) {                                                                      \
+        Value v;                                                                                             \
+        for (std::size_t j = 0; j < L; ++j) v[j] = num::kernels::name(a[j]);                                 \
+        return v;                                                                                            \
+    }
+#define FRAC_BINARY(name)                                                                                    \
+    static Value name(const Value& a, const Value& b) {                                                      \
+        Value v;                                                                                             \
+        for (std::size_t j = 0; j < L; ++j) v[j] = num::kernels::name(a[j], b[j]);                           \
+        return v;                                                                                            \
+    }
+    FRAC_LANE_OPERATIONS(FRAC_UNARY, FRAC_BINARY)
+#undef FRAC_UNARY
+#undef FRAC_BINARY
+};
+
+// The loop, compiled for any CPU.
+#include "backend/interp/flat_dispatch.inc"
+
+template <std::size_t L>
+void run_lanes(const FlatCode& c, double* r) {
+    dispatch<ScalarLanes<L>>(c, r);
+}
+
+#ifdef FRAC_LANE_KERNELS
+// lane_kernels on the four lower and four upper bounds of a slot.
+struct QuadLanes {
+    static constexpr std::size_t lanes = 4;
+    using Value = lane_kernels::Quad;
+#define FRAC_QUAD_TARGET __attribute__((target("avx2,fma"), always_inline)) static
+    FRAC_QUAD_TARGET Value load(const double* r, Slot s) {
+        return {_mm256_load_pd(r + s * 8), _mm256_load_pd(r + s * 8 + 4)};
+    }
+    FRAC_QUAD_TARGET void store(double* r, Slot s, const Value& v) {
+        _mm256_store_pd(r + s * 8, v.lo);
+        _mm256_store_pd(r + s * 8 + 4, v.hi);
+    }
+#define FRAC_UNARY(name)                                                                                     \
+    FRAC_QUAD_TARGET Value name(const Value& a) {                                                            \
+        return lane_kernels::name(a);                                                                        \
+    }
+#define FRAC_BINARY(name)                                                                                    \
+    FRAC_QUAD_TARGET Value name(const Value& a, const Value& b) {                                            \
+        return lane_kernels::name(a, b);                                                                     \
+    }
+    FRAC_LANE_OPERATIONS(FRAC_UNARY, FRAC_BINARY)
+#undef FRAC_UNARY
+#undef FRAC_BINARY
+#undef FRAC_QUAD_TARGET
+};
+static_assert(QuadLanes::lanes == lanes);
+
+// The loop again, compiled for AVX2 and FMA (a function cannot take its target from a template
+// argument, and GCC inlines no function with a computed goto).
+#pragma GCC push_options
+#pragma GCC target("avx2,fma")
+namespace avx2 {
+#include "backend/interp/flat_dispatch.inc"
+} // namespace avx2
+#pragma GCC pop_options
+
+void run_quads(const FlatCode& c, double* r) {
+    avx2::dispatch<QuadLanes>(c, r);
+}
+#endif
+#undef FRAC_LANE_OPERATIONS
 
 double elapsed_ms(std::chrono::steady_clock::time_point since) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
@@ -266,70 +391,26 @@ private:
         stats.calls += n;
         ThreadFile& file = thread_file();
         RegisterFile& regs = L == 1 ? file.single : file.side_by_side;
-        Interval* const r = regs.of(*code_, L);
+        double* const r = regs.of(*code_, L);
         const auto d = static_cast<std::size_t>(code_->inputs);
-        Interval* const in = r + code_->first_input() * L;
+        double* const in = r + code_->first_input() * 2 * L;
         for (std::size_t k = 0; k < d; ++k)
-            for (std::size_t j = 0; j < L; ++j) in[k * L + j] = boxes[(j < n ? j : 0) * d + k];
-        // Threaded dispatch (a computed goto per handler): each handler's jump has its own
-        // prediction history, which a single switch lacks.
-        static constexpr void* handlers[] = {&&add, &&sub, &&mul, &&neg,  &&sqr,  &&sqrt,
-                                             &&abs, &&min, &&max, &&powi, &&other};
-        static_assert(std::size(handlers) == static_cast<std::size_t>(Handler::other) + 1);
-        const FlatInstr* ins = code_->code.data();
-        const FlatInstr* const end = ins + code_->code.size();
-        // Operands are read before the result is written: a result's slot is never an operand's.
-#define FRAC_A r[ins->in[0] * L + j]
-#define FRAC_B r[ins->in[1] * L + j]
-#define FRAC_LANES(expression)                                                                               \
-    {                                                                                                        \
-        Interval t[L];                                                                                       \
-        for (std::size_t j = 0; j < L; ++j) t[j] = expression;                                               \
-        std::copy_n(t, L, r + ins->out * L);                                                                 \
-    }                                                                                                        \
-    if (++ins == end) goto done;                                                                             \
-    goto* handlers[static_cast<std::size_t>(ins->handler)]
-        if (ins == end) goto done;
-        goto* handlers[static_cast<std::size_t>(ins->handler)];
-    add:
-        FRAC_LANES(num::kernels::add(FRAC_A, FRAC_B));
-    sub:
-        FRAC_LANES(num::kernels::sub(FRAC_A, FRAC_B));
-    mul:
-        FRAC_LANES(num::kernels::mul(FRAC_A, FRAC_B));
-    neg:
-        FRAC_LANES(num::kernels::neg(FRAC_A));
-    sqr:
-        FRAC_LANES(num::kernels::sqr(FRAC_A));
-    sqrt:
-        FRAC_LANES(num::kernels::sqrt(FRAC_A));
-    abs:
-        FRAC_LANES(num::kernels::abs(FRAC_A));
-    min:
-        FRAC_LANES(num::kernels::min(FRAC_A, FRAC_B));
-    max:
-        FRAC_LANES(num::kernels::max(FRAC_A, FRAC_B));
-    powi:
-        FRAC_LANES(num::powi(FRAC_A, immediate(*ins)));
-    other:
-        FRAC_LANES(apply_other(*ins, r, L, j));
-#undef FRAC_LANES
-#undef FRAC_A
-#undef FRAC_B
-    done:
-        for (std::size_t j = 0; j < n; ++j) out[j] = r[code_->result * L + j];
+            for (std::size_t j = 0; j < L; ++j) {
+                const Interval& x = boxes[(j < n ? j : 0) * d + k];
+                in[k * 2 * L + j] = x.lo;
+                in[k * 2 * L + L + j] = x.hi;
+            }
+#ifdef FRAC_LANE_KERNELS
+        if (L == lanes && vector_lanes())
+            run_quads(*code_, r);
+        else
+#endif
+            run_lanes<L>(*code_, r);
+        for (std::size_t j = 0; j < n; ++j) out[j] = BoxValues{r, L, j}[code_->result];
         file.last_eval = id_;
         file.last_file = &regs;
         file.last_first = 0;
         file.last_count = n;
-    }
-
-    static Interval apply_other(const FlatInstr& ins, const Interval* r, std::size_t stride,
-                                std::size_t lane) {
-        Interval args[3];
-        for (int i = 0; i < ir::arity(ins.op); ++i)
-            args[i] = r[ins.in[static_cast<std::size_t>(i)] * stride + lane];
-        return ir::apply_interval(ins.op, args, 0);
     }
 
     static bool defined(const FlatInstr& ins, const BoxValues& r) {
@@ -376,7 +457,7 @@ private:
             k = 0;
         }
         const std::size_t stride = file.last_file == &file.single ? 1 : lanes;
-        const BoxValues r{file.last_file->values.data(), stride, k - file.last_first};
+        const BoxValues r{file.last_file->lines.data()->v, stride, k - file.last_first};
         file.prepare_push(c);
         const bool empties = mark_may_empty(file, r);
         const auto t1 = std::chrono::steady_clock::now();
@@ -492,6 +573,11 @@ private:
 };
 
 } // namespace
+
+bool use_vector_lanes(bool wanted) {
+    vector_lanes_wanted.store(wanted, std::memory_order_relaxed);
+    return vector_lanes();
+}
 
 bool runs_flat(const ir::Tape& tape) {
     if (tape.blocks.size() != 1 || !tape.series.empty()) return false;

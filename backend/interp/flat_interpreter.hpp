@@ -24,6 +24,11 @@ namespace frac::interp {
 // that fit 32 bits.
 bool runs_flat(const ir::Tape& tape);
 
+// Whether boxes evaluated side by side run on the vector kernels (backend/interp/lane_kernels.hpp) when
+// the CPU has them (the default), or on the scalar kernels lane by lane (the same results, for tests and
+// benchmarks). Returns whether the vector kernels are now in use.
+bool use_vector_lanes(bool wanted);
+
 // Requires runs_flat(tape).
 std::unique_ptr<ir::Evaluator> make_flat_interpreter(const ir::Tape& tape, const ir::EvalOptions& options);
 

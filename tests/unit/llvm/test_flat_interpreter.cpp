@@ -40,9 +40,53 @@ std::string mismatch(const char* what, std::size_t k, Interval flat, Interval re
     return std::string(what) + " " + std::to_string(k) + ": flat " + hex(flat) + ", reference " + hex(ref);
 }
 
+// Restores the default (vector kernels where the CPU has them) when a test ends.
+struct VectorLanes {
+    explicit VectorLanes(bool wanted) { interp::use_vector_lanes(wanted); }
+    ~VectorLanes() { interp::use_vector_lanes(true); }
+};
+
 } // namespace
 
+TEST_CASE("four boxes side by side: the vector kernels give the scalar kernels' bits on special bounds",
+          "[interp][flat]") {
+    if (!interp::use_vector_lanes(true)) {
+        WARN("this CPU has no AVX2: the vector kernels are not used");
+        return;
+    }
+    // Every interval over these bounds, and the empty one.
+    const double bounds[] = {-num::inf, -1e300, -3.0, -1.0, -0.5, -1e-310, -0.0,    0.0,
+                             1e-310,    0.5,    1.0,  2.75, 3.0,  1e300,   num::inf};
+    std::vector<Interval> intervals = {Interval::empty()};
+    for (double lo : bounds)
+        for (double hi : bounds)
+            if (lo <= hi && !(lo == num::inf || hi == -num::inf)) intervals.push_back({lo, hi});
+    using ir::Op;
+    for (const Op op : {Op::Add, Op::Sub, Op::Mul, Op::Neg, Op::Sqr, Op::Sqrt, Op::Abs, Op::Min, Op::Max}) {
+        ir::Graph g;
+        const ir::NodeId x = g.var(0), y = g.var(1);
+        const ir::Tape t = ir::build_tape(g, ir::arity(op) == 1 ? g.op(op, x) : g.op(op, x, y), 2);
+        REQUIRE(interp::runs_flat(t));
+        auto flat = interp::make_interpreter(t);
+        std::vector<Interval> boxes;
+        for (const Interval& a : intervals)
+            for (const Interval& b : intervals) boxes.insert(boxes.end(), {a, b});
+        const std::size_t count = boxes.size() / 2;
+        std::vector<Interval> out(count);
+        flat->eval_boxes(boxes.data(), count, out.data()); // four at a time
+        for (std::size_t k = 0; k < count; ++k) {
+            const Interval one = flat->eval_box(&boxes[2 * k]); // scalar kernels
+            INFO(ir::op_name(op) << " of " << hex(boxes[2 * k]) << ", " << hex(boxes[2 * k + 1]) << ": "
+                                 << mismatch("box", k, out[k], one));
+            REQUIRE(same(out[k], one));
+        }
+    }
+}
+
 TEST_CASE("the flat interpreter agrees with the tape interpreter bit for bit", "[interp][flat]") {
+    // Both kernels for boxes side by side.
+    const bool vector = GENERATE(true, false);
+    const VectorLanes lanes(vector);
     BoxMaker mk(8080);
     int flat_tapes = 0;
     for (int n = 0; n < 300; ++n) {
