@@ -8,6 +8,7 @@
 
 #include <array>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cstdint>
 #include <limits>
@@ -118,9 +119,6 @@ std::int64_t immediate(const FlatInstr& ins) {
     return ins.op == Op::PowI ? static_cast<std::int32_t>(ins.in[1]) : 0;
 }
 
-// Names of slots in a tape push (push): a result's number, or a tagged constant or input index.
-inline constexpr std::uint32_t constant_tag = 1u << 31, input_tag = 1u << 30, no_alias = ~0u;
-
 // Boxes one evaluation runs side by side: each instruction is dispatched once for all of them, and
 // their operations are independent (a cover's sibling cells share their parent's tape).
 inline constexpr std::size_t lanes = 4;
@@ -159,6 +157,15 @@ struct BoxValues {
     }
 };
 
+// What the push analysis found for one lane of a box evaluation (FlatInterpreter::analyse).
+struct LanePush {
+    bool decided = false;                // a choice was decided
+    bool too_long = false;               // the pruned code costs more than the rule allows
+    std::uint32_t kept = 0;              // instructions the pruned code keeps
+    std::uint32_t partial = 0;           // ... that may be undefined
+    std::vector<std::uint32_t> reversed; // the pruned code in reverse (ThreadFile)
+};
+
 // A thread's registers and push scratch, shared by every flat evaluator that runs on the thread.
 struct ThreadFile {
     RegisterFile single, side_by_side; // one box; `lanes` boxes
@@ -168,16 +175,17 @@ struct ThreadFile {
     std::uint64_t last_eval = 0;
     const RegisterFile* last_file = nullptr;
     std::size_t last_first = 0, last_count = 0; // the boxes first .. first + count - 1 of its batch
-    // Push scratch (backend/interp/flat_interpreter.cpp, push): by parent slot, the generation that
-    // reached it and its name in the pruned tape; by name, its alias and final slot; the pruned
-    // code in reverse, the parent slots of its constants; emptiness flags by slot.
-    std::vector<std::uint32_t> live;
-    std::uint32_t generation = 0;
-    std::vector<std::uint32_t> name;
-    std::vector<std::uint32_t> alias, final_slot;
-    std::vector<FlatInstr> reversed;
-    std::vector<Slot> constants;
-    std::vector<std::uint8_t> may_empty;
+    std::uint64_t evaluations = 0;              // box evaluations on this thread: names the last one
+    // The push analysis of the last box evaluation (analyse): which evaluation, for how many
+    // expected evaluations; by parent slot, the lanes whose pruned tape reads it and the lanes where
+    // it may be empty; by lane, its outcome and its pruned code in reverse (parent instruction << 2
+    // | 0 to keep it, or 1 + the operand a decided choice takes). final_slot: by parent slot, its
+    // slot in the tape being built.
+    std::uint64_t analysed = 0;
+    double analysed_expected = 0;
+    std::vector<std::uint8_t> lane_live, lane_empty;
+    std::vector<std::uint32_t> final_slot;
+    std::array<LanePush, lanes> pushes;
 
     double* points_of(const FlatCode& c) {
         if (point_code != c.id) {
@@ -189,20 +197,11 @@ struct ThreadFile {
     }
     // Sizes the push scratch for pushes from c.
     void prepare_push(const FlatCode& c) {
-        if (live.size() < c.num_slots) {
-            live.resize(c.num_slots, 0);
-            name.resize(c.num_slots);
-            alias.resize(c.num_slots);
+        if (lane_live.size() < c.num_slots) {
+            lane_live.resize(c.num_slots);
+            lane_empty.resize(c.num_slots);
             final_slot.resize(c.num_slots);
-            may_empty.resize(c.num_slots);
         }
-    }
-    std::uint32_t next_generation() {
-        if (++generation == 0) { // wrapped: forget every mark
-            std::fill(live.begin(), live.end(), 0);
-            generation = 1;
-        }
-        return generation;
     }
 };
 
@@ -411,6 +410,7 @@ private:
         file.last_file = &regs;
         file.last_first = 0;
         file.last_count = n;
+        ++file.evaluations;
     }
 
     static bool defined(const FlatInstr& ins, const BoxValues& r) {
@@ -418,32 +418,153 @@ private:
         return ir::defined_over_box(ins.op, a, ir::arity(ins.op) > 1 ? r[ins.in[1]] : a, immediate(ins));
     }
 
-    // Marks in file.may_empty the slots whose enclosure can become empty on a sub-box (the
-    // reference's emptiness analysis, on values alone: every slot of a flat tape has one). False,
-    // without a pass, when none can: every partial operation is defined over the box.
-    bool mark_may_empty(ThreadFile& file, const BoxValues& r) const {
+    // Marks in file.lane_empty, per slot, the lanes where its enclosure can become empty on a sub-box
+    // (the reference's emptiness analysis, on values alone: every slot of a flat tape has one), for the
+    // lanes of `box`. No pass, and false, when it can nowhere: in every lane every input is non-empty
+    // and every partial operation is defined.
+    bool mark_may_empty(ThreadFile& file, const BoxValues& box, unsigned lanes_of_box) const {
         const FlatCode& c = *code_;
-        bool any = false;
-        for (Slot s = c.first_input(); s < c.first_result(); ++s) any |= r[s].is_empty();
-        for (std::size_t k = 0; k < c.partial.size() && !any; ++k) {
-            const FlatInstr& ins = c.code[c.partial[k]];
-            any = !defined(ins, r);
-        }
+        const auto lane = [&](unsigned j) { return BoxValues{box.base, box.lanes, j}; };
+        const auto empty_inputs = [&](Slot s) {
+            unsigned m = 0;
+            for (unsigned j = 0; j < box.lanes; ++j)
+                m |= (lanes_of_box >> j & 1) && lane(j)[s].is_empty() ? 1u << j : 0;
+            return m;
+        };
+        const auto undefined = [&](const FlatInstr& ins, unsigned lanes_left) {
+            unsigned m = 0;
+            for (unsigned j = 0; j < box.lanes; ++j)
+                if (lanes_left >> j & 1) m |= defined(ins, lane(j)) ? 0 : 1u << j;
+            return m;
+        };
+        unsigned any = 0;
+        for (Slot s = c.first_input(); s < c.first_result(); ++s) any |= empty_inputs(s);
+        for (std::size_t k = 0; k < c.partial.size() && any != lanes_of_box; ++k)
+            any |= undefined(c.code[c.partial[k]], lanes_of_box & ~any);
         if (!any) return false;
-        std::fill_n(file.may_empty.begin(), c.constant_count(), 0);
-        for (Slot s = c.first_input(); s < c.first_result(); ++s) file.may_empty[s] = r[s].is_empty();
+        std::uint8_t* const empty = file.lane_empty.data();
+        std::fill_n(empty, c.constant_count(), 0);
+        for (Slot s = c.first_input(); s < c.first_result(); ++s)
+            empty[s] = static_cast<std::uint8_t>(empty_inputs(s));
         for (const FlatInstr& ins : c.code) {
-            bool empty = false;
-            for (int i = 0; i < ir::arity(ins.op); ++i)
-                empty |= file.may_empty[ins.in[static_cast<std::size_t>(i)]] != 0;
-            if (!empty && is_partial(ins.op)) empty = !defined(ins, r);
-            file.may_empty[ins.out] = empty;
+            unsigned m = 0;
+            for (int i = 0; i < ir::arity(ins.op); ++i) m |= empty[ins.in[static_cast<std::size_t>(i)]];
+            if (is_partial(ins.op)) m |= undefined(ins, any & ~m);
+            empty[ins.out] = static_cast<std::uint8_t>(m);
         }
         return true;
     }
 
+    // The push analysis of every box of the thread's last evaluation (this evaluator's) at once, so
+    // the parent's code and registers are read once for all the siblings that push: one backward pass
+    // over the live code, per lane deciding its choices from the registers (ir::decide_choice, the
+    // emptiness rule ir::defined_over_box), marking the slots its pruned tape reads and writing its
+    // pruned code in reverse; a lane stops as soon as its code costs more than push_max_cost.
+    void analyse(ThreadFile& file, double expected_evaluations) {
+        const FlatCode& c = *code_;
+        const std::size_t stride = file.last_file == &file.single ? 1 : lanes;
+        const BoxValues box{file.last_file->lines.data()->v, stride, 0};
+        const unsigned lanes_of_box = (1u << file.last_count) - 1;
+        file.prepare_push(c);
+        const bool empties = mark_may_empty(file, box, lanes_of_box);
+        const std::uint8_t* const empty = file.lane_empty.data();
+        std::uint8_t* const live = file.lane_live.data();
+        std::fill_n(live, c.num_slots, 0);
+        for (LanePush& p : file.pushes) {
+            p.decided = p.too_long = false;
+            p.kept = p.partial = 0;
+            p.reversed.clear();
+        }
+        const double max_cost = ir::push_max_cost(static_cast<double>(c.code.size()), expected_evaluations);
+        unsigned active = lanes_of_box; // lanes still within max_cost
+        live[c.result] = static_cast<std::uint8_t>(active);
+        for (std::size_t i = c.code.size(); i-- > 0 && active;) {
+            const FlatInstr& ins = c.code[i];
+            unsigned m = live[ins.out] & active;
+            if (!m) continue;
+            const auto index = static_cast<std::uint32_t>(i) << 2;
+            if (ir::is_choice(ins.op)) {
+                for (unsigned rest = m; rest; rest &= rest - 1) {
+                    const auto j = static_cast<unsigned>(std::countr_zero(rest));
+                    const BoxValues r{box.base, stride, j};
+                    const ir::Choice choice = ir::decide_choice(ins.op, r[ins.in[0]], r[ins.in[1]],
+                                                                empties && (empty[ins.in[0]] >> j & 1),
+                                                                empties && (empty[ins.in[1]] >> j & 1));
+                    if (choice == ir::Choice::both) continue;
+                    const std::uint32_t taken =
+                        (ins.op == Op::Select ? 1 : 0) + (choice == ir::Choice::second ? 1 : 0);
+                    LanePush& p = file.pushes[j];
+                    p.decided = true;
+                    p.reversed.push_back(index | (taken + 1));
+                    live[ins.in[taken]] |= static_cast<std::uint8_t>(1u << j);
+                    m &= ~(1u << j);
+                }
+                if (!m) continue;
+            }
+            for (unsigned rest = m; rest; rest &= rest - 1) {
+                const auto j = static_cast<unsigned>(std::countr_zero(rest));
+                LanePush& p = file.pushes[j];
+                // Past the most it may cost, with a choice decided: too little pruned.
+                if (p.decided && static_cast<double>(p.kept + 1) > max_cost) {
+                    p.too_long = true;
+                    active &= ~(1u << j);
+                    m &= ~(1u << j);
+                    continue;
+                }
+                p.reversed.push_back(index);
+                ++p.kept;
+                p.partial += is_partial(ins.op);
+            }
+            for (int a = 0; a < ir::arity(ins.op); ++a)
+                live[ins.in[static_cast<std::size_t>(a)]] |= static_cast<std::uint8_t>(m);
+        }
+        for (LanePush& p : file.pushes) p.too_long |= static_cast<double>(p.kept) > max_cost;
+        file.analysed = file.evaluations;
+        file.analysed_expected = expected_evaluations;
+    }
+
+    // The pruned tape of lane j of the analysis: its code forward in dense slots (constants in the
+    // parent's order, inputs, results in program order), a decided choice's result the slot of the
+    // operand it takes.
+    std::shared_ptr<FlatCode> build(ThreadFile& file, unsigned j) const {
+        const FlatCode& c = *code_;
+        const LanePush& p = file.pushes[j];
+        const std::uint8_t* const live = file.lane_live.data();
+        std::uint32_t* const final_slot = file.final_slot.data();
+        std::size_t constants = 0;
+        for (Slot s = 0; s < c.first_input(); ++s) constants += live[s] >> j & 1;
+        std::shared_ptr<FlatCode> pruned = FlatCode::make(c.inputs, constants, p.kept, p.partial);
+        for (Slot s = 0, k = 0; s < c.first_input(); ++s) {
+            if (!(live[s] >> j & 1)) continue;
+            pruned->constants[k] = c.constants[s];
+            pruned->constant_points[k] = c.constant_points[s];
+            final_slot[s] = k++;
+        }
+        for (Slot s = c.first_input(); s < c.first_result(); ++s)
+            final_slot[s] = pruned->first_input() + (s - c.first_input());
+        Slot next = pruned->first_result();
+        std::size_t k = 0;
+        for (auto e = p.reversed.rbegin(); e != p.reversed.rend(); ++e) {
+            const FlatInstr& ins = c.code[*e >> 2];
+            if (const std::uint32_t taken = *e & 3) {
+                final_slot[ins.out] = final_slot[ins.in[taken - 1]];
+                continue;
+            }
+            FlatInstr& n = pruned->code[k];
+            n = ins;
+            for (int a = 0; a < ir::arity(ins.op); ++a)
+                n.in[static_cast<std::size_t>(a)] = final_slot[ins.in[static_cast<std::size_t>(a)]];
+            final_slot[ins.out] = next;
+            n.out = next++;
+            pruned->note_instruction(k++);
+        }
+        pruned->result = final_slot[c.result];
+        return pruned;
+    }
+
     // A tape push: the pruned tape of the box, for this cell's descendants alone. The values are those
-    // of box k of this evaluator's last evaluation (checked: else the box is evaluated again).
+    // of box k of this evaluator's last evaluation (checked: else the box is evaluated again); the
+    // analysis of that evaluation serves every box of it.
     std::shared_ptr<ir::Evaluator> push(const Interval* box, std::size_t k, double expected_evaluations) {
         const FlatCode& c = *code_;
         if (!options_.prune || !c.has_choices || expected_evaluations <= interp_min_expected_evaluations)
@@ -456,112 +577,18 @@ private:
             stats = saved; // a recording is not an evaluation of the shape
             k = 0;
         }
-        const std::size_t stride = file.last_file == &file.single ? 1 : lanes;
-        const BoxValues r{file.last_file->lines.data()->v, stride, k - file.last_first};
-        file.prepare_push(c);
-        const bool empties = mark_may_empty(file, r);
+        const auto lane = static_cast<unsigned>(k - file.last_first);
+        if (file.analysed != file.evaluations || file.analysed_expected != expected_evaluations)
+            analyse(file, expected_evaluations);
         const auto t1 = std::chrono::steady_clock::now();
         specialize_stats.record_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();
         ++specialize_stats.requests;
-
-        // Backward, from the result: the live code, each decided choice replaced by the operand it
-        // takes. Slots reached get names: constants and inputs tagged, results numbered as reached;
-        // a choice's result is an alias of its operand's name (or the operand, computed earlier,
-        // takes the choice's name). The code goes to file.reversed, the parent's order reversed.
-        const std::uint32_t gen = file.next_generation();
-        std::uint32_t* const live = file.live.data();
-        std::uint32_t* const name = file.name.data();
-        std::uint32_t* const alias = file.alias.data();
-        file.reversed.clear();
-        file.constants.clear();
-        std::uint32_t results = 0;
-        const Slot first_input = c.first_input(), first_result = c.first_result();
-        const auto name_of = [&](Slot s) __attribute__((always_inline)) {
-            if (live[s] == gen) return name[s];
-            live[s] = gen;
-            std::uint32_t n;
-            if (s < first_input) {
-                n = constant_tag | static_cast<std::uint32_t>(file.constants.size());
-                file.constants.push_back(s);
-            } else if (s < first_result) {
-                n = input_tag | (s - first_input);
-            } else {
-                n = results++;
-                alias[n] = no_alias;
-            }
-            return name[s] = n;
-        };
-        const std::uint32_t result = name_of(c.result);
-        const double max_cost = ir::push_max_cost(static_cast<double>(c.code.size()), expected_evaluations);
-        std::size_t partial = 0;
-        bool decided = false, too_long = false;
-        for (std::size_t i = c.code.size(); i-- > 0;) {
-            const FlatInstr& ins = c.code[i];
-            if (live[ins.out] != gen) continue;
-            const std::uint32_t out = name[ins.out];
-            if (ir::is_choice(ins.op)) {
-                const ir::Choice choice = ir::decide_choice(ins.op, r[ins.in[0]], r[ins.in[1]],
-                                                            empties && file.may_empty[ins.in[0]],
-                                                            empties && file.may_empty[ins.in[1]]);
-                if (choice != ir::Choice::both) {
-                    decided = true;
-                    const Slot taken =
-                        ins.in[(ins.op == Op::Select ? 1 : 0) + (choice == ir::Choice::second ? 1 : 0)];
-                    if (live[taken] != gen && taken >= first_result) {
-                        live[taken] = gen;
-                        name[taken] = out;
-                    } else {
-                        alias[out] = name_of(taken);
-                    }
-                    continue;
-                }
-            }
-            // Past the most it may cost, with a choice decided: too little pruned (else nothing is).
-            if (decided && static_cast<double>(file.reversed.size() + 1) > max_cost) {
-                too_long = true;
-                break;
-            }
-            // Written in place: a copy built field by field and then moved whole stalls on the
-            // store forwarding of its fields.
-            FlatInstr& n = file.reversed.emplace_back(ins);
-            n.out = out;
-            for (int a = 0; a < ir::arity(ins.op); ++a)
-                n.in[static_cast<std::size_t>(a)] = name_of(ins.in[static_cast<std::size_t>(a)]);
-            partial += is_partial(ins.op);
-        }
-        too_long |= static_cast<double>(file.reversed.size()) > max_cost;
-        if (too_long || !decided) {
-            ++(decided ? specialize_stats.too_little : specialize_stats.unpruned);
-            specialize_stats.prune_ms += elapsed_ms(t1);
+        const LanePush& p = file.pushes[lane];
+        if (p.too_long || !p.decided) {
+            ++(p.decided ? specialize_stats.too_little : specialize_stats.unpruned);
             return nullptr;
         }
-
-        // Forward: the pruned tape in dense slots, results numbered in program order.
-        const std::size_t count = file.reversed.size();
-        std::shared_ptr<FlatCode> pruned = FlatCode::make(c.inputs, file.constants.size(), count, partial);
-        for (std::size_t k = 0; k < file.constants.size(); ++k) {
-            pruned->constants[k] = c.constants[file.constants[k]];
-            pruned->constant_points[k] = c.constant_points[file.constants[k]];
-        }
-        std::uint32_t* const final_slot = file.final_slot.data();
-        const Slot inputs_at = pruned->first_input();
-        const auto slot_of = [&](std::uint32_t n) -> Slot {
-            while (!(n & (constant_tag | input_tag)) && alias[n] != no_alias) n = alias[n];
-            if (n & constant_tag) return n & ~constant_tag;
-            if (n & input_tag) return inputs_at + (n & ~input_tag);
-            return final_slot[n];
-        };
-        Slot next = pruned->first_result();
-        for (std::size_t k = 0; k < count; ++k) {
-            FlatInstr& n = pruned->code[k];
-            n = file.reversed[count - 1 - k];
-            for (int a = 0; a < ir::arity(n.op); ++a)
-                n.in[static_cast<std::size_t>(a)] = slot_of(n.in[static_cast<std::size_t>(a)]);
-            final_slot[n.out] = next;
-            n.out = next++;
-            pruned->note_instruction(k);
-        }
-        pruned->result = slot_of(result);
+        std::shared_ptr<FlatCode> pruned = build(file, lane);
         ++specialize_stats.pushes;
         specialize_stats.prune_ms += elapsed_ms(t1);
         return std::make_shared<FlatInterpreter>(std::move(pruned), options_);
