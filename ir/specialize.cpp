@@ -143,10 +143,6 @@ private:
     std::vector<SlotFacts>& f_;
 };
 
-bool usable(Interval v) {
-    return !v.is_empty() && !std::isnan(v.lo) && !std::isnan(v.hi);
-}
-
 } // namespace
 
 bool defined_over_box(Op op, Interval a, Interval b, std::int64_t imm) {
@@ -157,39 +153,6 @@ bool defined_over_box(Op op, Interval a, Interval b, std::int64_t imm) {
     case Op::Pow: return a.lo > 0;
     case Op::PowI: return imm >= 0 || !contains_zero(a);
     default: return true;
-    }
-}
-
-Choice decide_choice(Op op, Interval a, Interval b, bool a_may_empty, bool b_may_empty) {
-    if (!usable(a) || !usable(b)) return Choice::both;
-    // The dropped operand must not become empty below (it would empty the result).
-    const bool keep_a = !b_may_empty, keep_b = !a_may_empty;
-    // Min and max need disjoint operands: where they touch, the result's bounds could be a 0 of
-    // the other operand's sign. On truth values (exactly 0 or 1) and is min and or is max, and
-    // false decides an and, true an or, whatever the other operand.
-    switch (op) {
-    case Op::Min:
-        if (b.hi < a.lo && keep_b) return Choice::second;
-        if (a.hi < b.lo && keep_a) return Choice::first;
-        return Choice::both;
-    case Op::And:
-        if (a.hi <= b.lo && keep_a) return Choice::first;
-        if (b.hi <= a.lo && keep_b) return Choice::second;
-        return Choice::both;
-    case Op::Max:
-        if (b.lo > a.hi && keep_b) return Choice::second;
-        if (a.lo > b.hi && keep_a) return Choice::first;
-        return Choice::both;
-    case Op::Or:
-        if (a.lo >= b.hi && keep_a) return Choice::first;
-        if (b.lo >= a.hi && keep_b) return Choice::second;
-        return Choice::both;
-    case Op::Select: // a is the condition
-        if (a_may_empty) return Choice::both;
-        if (a == tv_true) return Choice::first;
-        if (a == tv_false) return Choice::second;
-        return Choice::both;
-    default: return Choice::both;
     }
 }
 

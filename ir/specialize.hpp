@@ -17,8 +17,10 @@
 #pragma once
 
 #include "ir/evaluator.hpp"
+#include "ir/semantics.hpp"
 #include "ir/tape.hpp"
 
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <map>
@@ -47,7 +49,41 @@ bool defined_over_box(Op op, Interval a, Interval b, std::int64_t imm);
 // The choice a min/max/and/or/select makes over a box where its operands (select: the condition
 // and the then-value) have the enclosures a and b; `x_may_empty`: that operand's enclosure can be
 // empty on a sub-box (it is then never dropped, nor a select decided by it).
-Choice decide_choice(Op op, Interval a, Interval b, bool a_may_empty, bool b_may_empty);
+// Inline: tape pushes call it for every choice of the live code.
+inline Choice decide_choice(Op op, Interval a, Interval b, bool a_may_empty, bool b_may_empty) {
+    // Enclosures that are empty or NaN decide nothing.
+    const auto usable = [](Interval v) { return !v.is_empty() && !std::isnan(v.lo) && !std::isnan(v.hi); };
+    if (!usable(a) || !usable(b)) return Choice::both;
+    // The dropped operand must not become empty below (it would empty the result).
+    const bool keep_a = !b_may_empty, keep_b = !a_may_empty;
+    // Min and max need disjoint operands: where they touch, the result's bounds could be a 0 of
+    // the other operand's sign. On truth values (exactly 0 or 1) and is min and or is max, and
+    // false decides an and, true an or, whatever the other operand.
+    switch (op) {
+    case Op::Min:
+        if (b.hi < a.lo && keep_b) return Choice::second;
+        if (a.hi < b.lo && keep_a) return Choice::first;
+        return Choice::both;
+    case Op::And:
+        if (a.hi <= b.lo && keep_a) return Choice::first;
+        if (b.hi <= a.lo && keep_b) return Choice::second;
+        return Choice::both;
+    case Op::Max:
+        if (b.lo > a.hi && keep_b) return Choice::second;
+        if (a.lo > b.hi && keep_a) return Choice::first;
+        return Choice::both;
+    case Op::Or:
+        if (a.lo >= b.hi && keep_a) return Choice::first;
+        if (b.lo >= a.hi && keep_b) return Choice::second;
+        return Choice::both;
+    case Op::Select: // a is the condition
+        if (a_may_empty) return Choice::both;
+        if (a == tv_true) return Choice::first;
+        if (a == tv_false) return Choice::second;
+        return Choice::both;
+    default: return Choice::both;
+    }
+}
 
 // The choices of the block-0 instructions (one entry per instruction of tape.blocks[0], `both` for
 // any other) after an interval evaluation of `tape` over a box; `slots` is the evaluator's register

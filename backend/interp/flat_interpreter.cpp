@@ -48,16 +48,13 @@ std::uint64_t next_id() {
     return ++counter;
 }
 
+// Instruction k of a flat tape writes slot first_result() + k (FlatCode): no result field, 16 bytes.
 struct FlatInstr {
-    Slot out;
     std::array<Slot, 3> in; // operands; powi: in[1] holds the exponent
     Op op;
     Handler handler;
 };
-
-FlatInstr flat_instr(Op op, Slot out, std::array<Slot, 3> in) {
-    return {out, in, op, handler_of(op)};
-}
+static_assert(sizeof(FlatInstr) == 16);
 
 bool is_partial(Op op) {
     return op == Op::Div || op == Op::Sqrt || op == Op::Log || op == Op::Pow || op == Op::PowI;
@@ -212,15 +209,15 @@ ThreadFile& thread_file() {
 
 // Instruction `ins` on each of the L boxes of register file r, by the reference's operations (powi and
 // the operations without a handler). Out of line: compiled for any CPU, called from every loop.
-[[gnu::noinline]] void apply_by_lane(const FlatInstr& ins, double* r, std::size_t L) {
+[[gnu::noinline]] void apply_by_lane(const FlatInstr& ins, Slot out_slot, double* r, std::size_t L) {
     for (std::size_t j = 0; j < L; ++j) {
         const BoxValues v{r, L, j};
         Interval args[3];
         for (int i = 0; i < ir::arity(ins.op); ++i) args[i] = v[ins.in[static_cast<std::size_t>(i)]];
         const Interval out =
             ins.op == Op::PowI ? num::powi(args[0], immediate(ins)) : ir::apply_interval(ins.op, args, 0);
-        r[ins.out * 2 * L + j] = out.lo;
-        r[ins.out * 2 * L + L + j] = out.hi;
+        r[out_slot * 2 * L + j] = out.lo;
+        r[out_slot * 2 * L + L + j] = out.hi;
     }
 }
 
@@ -344,10 +341,11 @@ public:
         ++stats.calls;
         double* r = thread_file().points_of(*code_);
         std::copy_n(coords, code_->inputs, r + code_->first_input());
+        Slot out = code_->first_result();
         for (const FlatInstr& ins : code_->code) {
             double args[3];
             for (int i = 0; i < ir::arity(ins.op); ++i) args[i] = r[ins.in[static_cast<std::size_t>(i)]];
-            r[ins.out] = ir::apply_point(ins.op, args, immediate(ins));
+            r[out++] = ir::apply_point(ins.op, args, immediate(ins));
         }
         return r[code_->result];
     }
@@ -446,11 +444,12 @@ private:
         std::fill_n(empty, c.constant_count(), 0);
         for (Slot s = c.first_input(); s < c.first_result(); ++s)
             empty[s] = static_cast<std::uint8_t>(empty_inputs(s));
+        Slot out = c.first_result();
         for (const FlatInstr& ins : c.code) {
             unsigned m = 0;
             for (int i = 0; i < ir::arity(ins.op); ++i) m |= empty[ins.in[static_cast<std::size_t>(i)]];
             if (is_partial(ins.op)) m |= undefined(ins, any & ~m);
-            empty[ins.out] = static_cast<std::uint8_t>(m);
+            empty[out++] = static_cast<std::uint8_t>(m);
         }
         return true;
     }
@@ -480,7 +479,7 @@ private:
         live[c.result] = static_cast<std::uint8_t>(active);
         for (std::size_t i = c.code.size(); i-- > 0 && active;) {
             const FlatInstr& ins = c.code[i];
-            unsigned m = live[ins.out] & active;
+            unsigned m = live[c.first_result() + i] & active;
             if (!m) continue;
             const auto index = static_cast<std::uint32_t>(i) << 2;
             if (ir::is_choice(ins.op)) {
@@ -546,16 +545,16 @@ private:
         std::size_t k = 0;
         for (auto e = p.reversed.rbegin(); e != p.reversed.rend(); ++e) {
             const FlatInstr& ins = c.code[*e >> 2];
+            const Slot out = c.first_result() + (*e >> 2);
             if (const std::uint32_t taken = *e & 3) {
-                final_slot[ins.out] = final_slot[ins.in[taken - 1]];
+                final_slot[out] = final_slot[ins.in[taken - 1]];
                 continue;
             }
             FlatInstr& n = pruned->code[k];
             n = ins;
             for (int a = 0; a < ir::arity(ins.op); ++a)
                 n.in[static_cast<std::size_t>(a)] = final_slot[ins.in[static_cast<std::size_t>(a)]];
-            final_slot[ins.out] = next;
-            n.out = next++;
+            final_slot[out] = next++;
             pruned->note_instruction(k++);
         }
         pruned->result = final_slot[c.result];
@@ -644,11 +643,11 @@ std::unique_ptr<ir::Evaluator> make_flat_interpreter(const ir::Tape& tape, const
     Slot next = code->first_result();
     for (std::size_t k = 0; k < instructions.size(); ++k) {
         const ir::Instr& ins = instructions[k];
-        FlatInstr n = flat_instr(ins.op, ins.out, ins.in);
+        FlatInstr n{ins.in, ins.op, handler_of(ins.op)};
         for (int i = 0; i < ir::arity(ins.op); ++i)
             n.in[static_cast<std::size_t>(i)] = slot(ins.in[static_cast<std::size_t>(i)]);
         if (ins.op == Op::PowI) n.in[1] = static_cast<Slot>(static_cast<std::int32_t>(ins.imm));
-        n.out = renumber[ins.out] = next++;
+        renumber[ins.out] = next++;
         code->code[k] = n;
         code->note_instruction(k);
     }
