@@ -308,12 +308,20 @@ static_assert(QuadLanes::lanes == lanes);
 
 // The loop again, compiled for AVX2 and FMA (a function cannot take its target from a template
 // argument, and GCC inlines no function with a computed goto).
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2,fma"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
+#endif
 namespace avx2 {
 #include "backend/interp/flat_dispatch.inc"
 } // namespace avx2
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 
 void run_quads(const FlatCode& c, double* r) {
     avx2::dispatch<QuadLanes>(c, r);
@@ -420,7 +428,8 @@ private:
     // (the reference's emptiness analysis, on values alone: every slot of a flat tape has one), for the
     // lanes of `box`. No pass, and false, when it can nowhere: in every lane every input is non-empty
     // and every partial operation is defined.
-    bool mark_may_empty(ThreadFile& file, const BoxValues& box, unsigned lanes_of_box) const {
+    [[gnu::noinline]] bool mark_may_empty(ThreadFile& file, const BoxValues& box,
+                                          unsigned lanes_of_box) const {
         const FlatCode& c = *code_;
         const auto lane = [&](unsigned j) { return BoxValues{box.base, box.lanes, j}; };
         const auto empty_inputs = [&](Slot s) {
@@ -459,7 +468,7 @@ private:
     // over the live code, per lane deciding its choices from the registers (ir::decide_choice, the
     // emptiness rule ir::defined_over_box), marking the slots its pruned tape reads and writing its
     // pruned code in reverse; a lane stops as soon as its code costs more than push_max_cost.
-    void analyse(ThreadFile& file, double expected_evaluations) {
+    [[gnu::noinline]] void analyse(ThreadFile& file, double expected_evaluations) {
         const FlatCode& c = *code_;
         const std::size_t stride = file.last_file == &file.single ? 1 : lanes;
         const BoxValues box{file.last_file->lines.data()->v, stride, 0};
@@ -525,7 +534,7 @@ private:
     // The pruned tape of lane j of the analysis: its code forward in dense slots (constants in the
     // parent's order, inputs, results in program order), a decided choice's result the slot of the
     // operand it takes.
-    std::shared_ptr<FlatCode> build(ThreadFile& file, unsigned j) const {
+    [[gnu::noinline]] std::shared_ptr<FlatCode> build(ThreadFile& file, unsigned j) const {
         const FlatCode& c = *code_;
         const LanePush& p = file.pushes[j];
         const std::uint8_t* const live = file.lane_live.data();
