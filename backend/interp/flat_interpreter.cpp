@@ -161,6 +161,7 @@ struct LanePush {
     std::uint32_t kept = 0;              // instructions the pruned code keeps
     std::uint32_t partial = 0;           // ... that may be undefined
     std::vector<std::uint32_t> reversed; // the pruned code in reverse (ThreadFile)
+    std::weak_ptr<ir::Evaluator> built;  // the evaluator of the pruned tape, once built
 };
 
 // A thread's registers and push scratch, shared by every flat evaluator that runs on the thread.
@@ -482,6 +483,7 @@ private:
             p.decided = p.too_long = false;
             p.kept = p.partial = 0;
             p.reversed.clear();
+            p.built.reset();
         }
         const double max_cost = ir::push_max_cost(static_cast<double>(c.code.size()), expected_evaluations);
         unsigned active = lanes_of_box; // lanes still within max_cost
@@ -596,10 +598,20 @@ private:
             ++(p.decided ? specialize_stats.too_little : specialize_stats.unpruned);
             return nullptr;
         }
-        std::shared_ptr<FlatCode> pruned = build(file, lane);
+        // Siblings often decide every choice alike: a lane whose pruned code equals another's shares
+        // its evaluator (one tape, one variant of the cover).
+        for (const LanePush& other : file.pushes)
+            if (&other != &p && other.reversed == p.reversed)
+                if (std::shared_ptr<ir::Evaluator> shared = other.built.lock()) {
+                    ++specialize_stats.hits;
+                    specialize_stats.prune_ms += elapsed_ms(t1);
+                    return shared;
+                }
+        auto pushed = std::make_shared<FlatInterpreter>(build(file, lane), options_);
+        file.pushes[lane].built = pushed;
         ++specialize_stats.pushes;
         specialize_stats.prune_ms += elapsed_ms(t1);
-        return std::make_shared<FlatInterpreter>(std::move(pruned), options_);
+        return pushed;
     }
 
     std::shared_ptr<const FlatCode> code_;
