@@ -1,5 +1,6 @@
 // What a JIT cover costs beyond evaluation, and how it scales to two threads (issue 13): the carpet's
-// RSS cover against the JIT's kernel alone on the same cells, and a deep cover on 1 and 2 threads.
+// RSS cover against the JIT's kernel alone on the same cells (boxes in memory, eval_boxes; and the
+// cells' coordinates with their level's grid, eval_cells), and a deep cover on 1 and 2 threads.
 // Every variant in this one run, repetitions interleaved, medians.
 //
 //   bench_cover [depth=10] [deep_depth=12] [reps=5]
@@ -57,14 +58,29 @@ int main(int argc, char** argv) {
     }
     const std::size_t n = boxes.size() / 2;
     std::vector<ir::Interval> out(n);
+    // ... and the same cells by level, for eval_cells alone: their coordinates and the level's grid.
+    std::vector<ir::CellGrid> grids(static_cast<std::size_t>(depth) + 1);
+    std::vector<std::vector<std::uint32_t>> coords(grids.size());
+    std::vector<ir::Interval> points;
+    for (int k = 0; k <= depth; ++k)
+        rt::grid::level_cells(s.box, cells.cells_per_axis(k), grids[static_cast<std::size_t>(k)], points);
+    for (const rt::Cell& cell : cells.cells)
+        coords[cell.level].insert(coords[cell.level].end(), {cell.ix, cell.iy, 0, 0});
+    std::vector<ir::CellVerdict> verdicts(n);
 
-    std::vector<double> kernel, one, two, deep_one, deep_two;
+    std::vector<double> kernel, cell_kernel, one, two, deep_one, deep_two;
     std::uint64_t deep_cells = 0;
     for (int r = 0; r < reps; ++r) {
         auto t0 = bench::Clock::now();
         for (std::size_t i = 0; i < n; i += 4096)
             jt->eval_boxes(boxes.data() + 2 * i, std::min<std::size_t>(4096, n - i), out.data() + i);
         kernel.push_back(bench::seconds_since(t0));
+        t0 = bench::Clock::now();
+        for (std::size_t k = 0; k < grids.size(); ++k)
+            for (std::size_t i = 0; 4 * i < coords[k].size(); i += 4096)
+                jt->eval_cells(grids[k], coords[k].data() + 4 * i, 4,
+                               std::min<std::size_t>(4096, coords[k].size() / 4 - i), verdicts.data(), false);
+        cell_kernel.push_back(bench::seconds_since(t0));
         one.push_back(cover(*jt, s.box, depth, 1).seconds);
         two.push_back(cover(*jt, s.box, depth, 2).seconds);
         const rt::RssResult d1 = cover(*jt, s.box, deep, 1);
@@ -77,6 +93,7 @@ int main(int argc, char** argv) {
     fmt::print("JIT carpet cover, depth {} ({} evaluations), median of {} (ns per evaluation)\n", depth, n,
                reps);
     fmt::print("  kernel alone (eval_boxes, batches of 4096)   {:8.1f}\n", k);
+    fmt::print("  cells alone (eval_cells, batches of 4096)    {:8.1f}\n", median(cell_kernel) * ns);
     fmt::print(
         "  cover, 1 thread                              {:8.1f}   beyond the kernel {:6.1f} ({:.0f} %)\n", c1,
         c1 - k, 100 * (c1 - k) / c1);

@@ -4,10 +4,12 @@
 
 #include "numeric/interval.hpp"
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace frac::ir {
 
@@ -52,6 +54,63 @@ struct SpecializeStats {
     SpecializeStats& operator+=(const SpecializeStats& o);
 };
 
+// What a cover concludes of a cell from the enclosure [lo, hi] of f over its box (runtime/rss.hpp):
+//  - hi < 0, or hi <= 0 with closed_inside               -> inside
+//  - lo > 0, or an empty enclosure (f undefined on the box) -> outside
+//  - anything else, including a NaN bound                -> undecided (the safe answer)
+// The NaN test comes first because an interval with a NaN bound also looks empty (!(lo <= hi)).
+enum class CellVerdict : std::uint8_t { inside = 0, outside = 1, undecided = 2 };
+
+inline CellVerdict classify(Interval z, bool closed_inside) {
+    if (std::isnan(z.lo) || std::isnan(z.hi)) return CellVerdict::undecided;
+    if (z.lo > z.hi) return CellVerdict::outside;
+    if (z.hi < 0 || (closed_inside && z.hi <= 0)) return CellVerdict::inside;
+    if (z.lo > 0) return CellVerdict::outside;
+    return CellVerdict::undecided;
+}
+
+// The cells of one level of a regular grid, for Evaluator::eval_cells: per axis, the interval of each
+// cell along it; cell (i, j, k) is the box axis(0)[i] x axis(1)[j] x axis(2)[k]. Filled once per level
+// (the storage is kept from one fill to the next), then read by any number of threads.
+class CellGrid {
+public:
+    // `dimension` axes (1 to 3) of cells[a] cells each (at most 2^32: coordinates are 32-bit); entry i
+    // of axis a is fill(a, i). Throws std::invalid_argument for a dimension or a count out of range.
+    template <class Fill>
+    void assign(int dimension, const std::uint64_t* cells, Fill&& fill) {
+        check_shape(dimension, cells);
+        dimension_ = dimension;
+        nonempty_ = true;
+        for (int a = 0; a < dimension; ++a) {
+            std::vector<Interval>& axis = axes_[a];
+            axis.resize(static_cast<std::size_t>(cells[a]));
+            for (std::size_t i = 0; i < axis.size(); ++i) {
+                axis[i] = fill(a, static_cast<std::uint64_t>(i));
+                nonempty_ &= axis[i].lo <= axis[i].hi;
+            }
+        }
+    }
+
+    int dimension() const { return dimension_; }
+    std::size_t cells(int axis) const { return axes_[axis].size(); }
+    const Interval* axis(int a) const { return axes_[a].data(); }
+    // Every entry is a non-empty interval (lo <= hi, no NaN bound), hence so is every cell's box.
+    bool nonempty() const { return nonempty_; }
+    // The box of the cell at `coords` (one coordinate per axis, in range).
+    void box(const std::uint32_t* coords, Interval* out) const {
+        for (int a = 0; a < dimension_; ++a) out[a] = axes_[a][coords[a]];
+    }
+    // Throws std::invalid_argument unless the grid has `dimension` axes and stride >= dimension, and
+    // std::out_of_range unless the coordinates of the n cells coords[k * stride + a] are in range.
+    void check(int dimension, const std::uint32_t* coords, std::size_t stride, std::size_t n) const;
+
+private:
+    static void check_shape(int dimension, const std::uint64_t* cells);
+    int dimension_ = 0;
+    bool nonempty_ = false;
+    std::vector<Interval> axes_[3];
+};
+
 class Evaluator {
 public:
     virtual ~Evaluator() = default;
@@ -70,6 +129,13 @@ public:
     // Batches: `coords` / `boxes` hold n consecutive groups of dimension() values.
     virtual void eval_points(const double* coords, std::size_t n, double* out);
     virtual void eval_boxes(const Interval* boxes, std::size_t n, Interval* out);
+    // The verdicts of n cells of a grid: out[k] = classify(enclosure over the box of cell k), where
+    // cell k has the coordinates coords[k * stride + a] (a < dimension()). The same evaluations, bits
+    // and counters as eval_boxes on the cells' boxes; an engine may build the boxes and classify in its
+    // own code (the JIT), the default builds them here and calls eval_boxes. Throws as
+    // CellGrid::check does.
+    virtual void eval_cells(const CellGrid& grid, const std::uint32_t* coords, std::size_t stride,
+                            std::size_t n, CellVerdict* out, bool closed_inside);
 
     // An independent evaluator of the same function, for use on another thread.
     virtual std::unique_ptr<Evaluator> clone() const = 0;

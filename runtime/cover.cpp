@@ -30,6 +30,26 @@ Interval width(Interval axis) {
     return num::sub(Interval(axis.hi), Interval(axis.lo));
 }
 
+void level_cells(const std::vector<Interval>& root, std::uint64_t n, ir::CellGrid& out,
+                 std::vector<Interval>& points) {
+    num::UpwardRounding up;
+    const std::size_t d = root.size(), m = static_cast<std::size_t>(n) + 1;
+    points.resize(d * m);
+    for (std::size_t a = 0; a < d; ++a) {
+        const Interval w = grid::width(root[a]);
+        for (std::size_t j = 0; j < m; ++j) points[a * m + j] = grid::point(root[a], w, j, n);
+    }
+    const std::uint64_t cells[3] = {n, n, n};
+    out.assign(static_cast<int>(d), cells, [&](int a, std::uint64_t i) {
+        const auto ax = static_cast<std::size_t>(a);
+        const Interval x = root[ax];
+        const Interval* p = &points[ax * m];
+        // cell(x, w, i, n) from the points
+        return Interval{i == 0 ? x.lo : std::max(x.lo, p[i].lo),
+                        i + 1 >= n ? x.hi : std::min(x.hi, p[i + 1].hi)};
+    });
+}
+
 } // namespace grid
 
 std::uint64_t Cover::cells_per_axis(int level) const {

@@ -4,6 +4,7 @@
 // dimensions and meshes take a Cover, whatever made it.
 #pragma once
 
+#include "ir/evaluator.hpp"
 #include "numeric/interval.hpp"
 
 #include <cstdint>
@@ -65,6 +66,11 @@ Interval point(Interval axis, Interval w, std::uint64_t j, std::uint64_t n);
 Interval cell(Interval axis, Interval w, std::uint64_t i, std::uint64_t n);
 // Enclosure of the root's width along an axis. Requires upward rounding.
 Interval width(Interval axis);
+// The cells of a level with n cells per axis over `root` (2 or 3 axes) into `out`, for
+// Evaluator::eval_cells: entry i of axis a is cell(root[a], width(root[a]), i, n), each grid point
+// computed once (into `points`, the caller's scratch). Sets upward rounding itself.
+void level_cells(const std::vector<Interval>& root, std::uint64_t n, ir::CellGrid& out,
+                 std::vector<Interval>& points);
 } // namespace grid
 
 } // namespace frac::rt

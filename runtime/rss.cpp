@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <stdexcept>
 #include <unordered_map>
 #include <utility>
@@ -32,23 +33,17 @@ std::string byte_text(double bytes) {
 using Clock = std::chrono::steady_clock;
 
 // Position of a cell in the grid of its level, and the function it evaluates (0: the shape's, else
-// a pruned one, Runner::variants_).
+// a pruned one, Runner::variants_). The coordinates are those of Evaluator::eval_cells with a stride of
+// pos_stride.
 struct Pos {
     std::uint32_t ix, iy, iz;
     std::uint32_t variant = 0;
 };
+constexpr std::size_t pos_stride = sizeof(Pos) / sizeof(std::uint32_t);
+static_assert(sizeof(Pos) == 4 * sizeof(std::uint32_t) && offsetof(Pos, iy) == 4 && offsetof(Pos, iz) == 8);
 
-enum class Verdict { inside, outside, undecided };
-
-// See the header for the rules. The NaN test comes first because an interval with a NaN bound
-// also looks "empty" (!(lo <= hi)), and a NaN says nothing about the box.
-Verdict classify(Interval z, bool closed_inside) {
-    if (std::isnan(z.lo) || std::isnan(z.hi)) return Verdict::undecided;
-    if (z.lo > z.hi) return Verdict::outside; // empty: f undefined on the whole box
-    if (z.hi < 0 || (closed_inside && z.hi <= 0)) return Verdict::inside;
-    if (z.lo > 0) return Verdict::outside;
-    return Verdict::undecided;
-}
+using ir::CellVerdict;
+using ir::classify; // the header's rules
 
 void validate(const ir::Evaluator& f, const std::vector<Interval>& root, const RssOptions& o) {
     const int d = static_cast<int>(root.size());
@@ -101,8 +96,8 @@ struct Chunk {
 // Cells [first, first + cells.size()) of a level, in row-major order, and what evaluating them gives.
 struct Batch {
     std::uint64_t first = 0;
-    std::vector<Pos> cells; // made by the chunks
-    std::vector<Interval> boxes, out;
+    std::vector<Pos> cells;               // made by the chunks
+    std::vector<CellVerdict> verdicts;    // ... and what they gave
     std::vector<std::uint32_t> undecided; // each chunk's undecided cells, from its begin
     std::vector<Cell> kept;               // the cells as kept (keep_cells)
     // Pruned functions asked for by the chunks (for variants whose evaluators answer independently of
@@ -130,11 +125,49 @@ struct LevelVariant {
     double instructions;           // of its function
 };
 
-// Per-thread room for a chunk whose cells evaluate several variants.
+// Per-thread room: a chunk's cells sorted by variant (a chunk whose cells evaluate several), and the
+// boxes and enclosures of cells evaluated box by box (pruning in the chunks, or no grid table).
 struct ChunkScratch {
     std::vector<std::uint32_t> order;
+    std::vector<Pos> cells;
+    std::vector<CellVerdict> verdicts;
     std::vector<Interval> boxes, out;
 };
+
+ChunkScratch& scratch() {
+    thread_local ChunkScratch s;
+    return s;
+}
+
+// Buffers a run leaves to the next run on its thread (covers in a loop: benchmarks, tests, a library's
+// caller), so that the next one neither allocates nor faults them in again; each up to
+// kept_buffer_bytes, so that a deep cover does not hold its memory afterwards.
+struct KeptBuffers {
+    std::vector<Pos> frontiers[2];
+    std::vector<Pos> cells[2];
+    std::vector<CellVerdict> verdicts[2];
+    std::vector<std::uint32_t> undecided[2];
+};
+constexpr std::size_t kept_buffer_bytes = std::size_t{16} << 20;
+
+KeptBuffers& kept_buffers() {
+    thread_local KeptBuffers k;
+    return k;
+}
+
+template <class T>
+void take_buffer(std::vector<T>& to, std::vector<T>& from) {
+    to = std::move(from);
+    from = {};
+    to.clear();
+}
+
+template <class T>
+void leave_buffer(std::vector<T>& to, std::vector<T>& from) {
+    if (from.capacity() * sizeof(T) > kept_buffer_bytes) return;
+    from.clear();
+    to = std::move(from);
+}
 
 // One run of the subdivision. Holds the frontier of the current level (its undecided cells) and
 // the batch being filled, nothing else unless keep_cells.
@@ -157,6 +190,14 @@ public:
         variants_[0].prune_in_chunks = f_.may_specialize() && f_.specializes_independently();
         // Each thread gets a batch of its own per flush.
         flush_at_ = r_.options.batch * static_cast<std::size_t>(threads_);
+        KeptBuffers& k = kept_buffers();
+        take_buffer(next_, k.frontiers[0]);
+        take_buffer(parents_, k.frontiers[1]);
+        for (int i = 0; i < 2; ++i) {
+            take_buffer(batches_[i].cells, k.cells[i]);
+            take_buffer(batches_[i].verdicts, k.verdicts[i]);
+            take_buffer(batches_[i].undecided, k.undecided[i]);
+        }
     }
 
     ~Runner() {
@@ -169,6 +210,14 @@ public:
                 }
             }
         for (const Variant& v : variants_) count_work(v);
+        KeptBuffers& k = kept_buffers();
+        leave_buffer(k.frontiers[0], next_);
+        leave_buffer(k.frontiers[1], parents_);
+        for (int i = 0; i < 2; ++i) {
+            leave_buffer(k.cells[i], batches_[i].cells);
+            leave_buffer(k.verdicts[i], batches_[i].verdicts);
+            leave_buffer(k.undecided[i], batches_[i].undecided);
+        }
     }
 
     void run() {
@@ -255,23 +304,17 @@ private:
             level_variants_.push_back({v.workers.data(), prune, v.instructions});
             prune_in_chunks_ |= prune;
         }
-        // The level's grid points per axis, computed once (each cell would otherwise compute two per
-        // axis with three interval operations each); the same expression, so the same boxes.
-        grid_.assign(n_ <= grid_table_limit ? static_cast<std::size_t>(d_) : 0, {});
-        if (grid_.empty()) return;
-        num::UpwardRounding up;
-        for (std::size_t a = 0; a < grid_.size(); ++a) {
-            grid_[a].resize(n_ + 1);
-            for (std::uint64_t j = 0; j <= n_; ++j) grid_[a][j] = grid::point(r_.root[a], width_[a], j, n_);
-        }
+        // The level's cells per axis, computed once (each cell would otherwise compute two grid points
+        // per axis with three interval operations each): the same boxes as grid::cell. Evaluators build
+        // the cells' boxes from it (Evaluator::eval_cells).
+        table_ = n_ <= grid_table_limit;
+        if (table_) grid::level_cells(r_.root, n_, grid_, points_);
     }
 
-    // Outward box of cell i of the level along `axis` (cell_axis, from the level's table when it has one).
+    // Outward box of cell i of the level along `axis` (grid::cell, from the level's table when it has one).
     Interval cell_interval(std::size_t axis, std::uint32_t i) const {
-        if (grid_.empty()) return grid::cell(r_.root[axis], width_[axis], i, n_);
-        const Interval root = r_.root[axis];
-        return {i == 0 ? root.lo : std::max(root.lo, grid_[axis][i].lo),
-                i + 1 >= n_ ? root.hi : std::min(root.hi, grid_[axis][i + 1].hi)};
+        if (!table_) return grid::cell(r_.root[axis], width_[axis], i, n_);
+        return grid_.axis(static_cast<int>(axis))[i];
     }
 
     // Evaluates the level's cells, from the plan of start_level, batch by batch.
@@ -307,11 +350,12 @@ private:
         level_cells_ = first;
     }
 
-    // Cells [c, c + n) of the level, in its order (plan_children; level 0 is the root).
-    void children(std::uint64_t c, std::size_t n, Pos* out) const {
+    // Cells [c, c + n) of the level, in its order (plan_children; level 0 is the root). Returns whether
+    // they all evaluate the same variant.
+    bool children(std::uint64_t c, std::size_t n, Pos* out) const {
         if (level_ == 0) {
             std::fill_n(out, n, Pos{0, 0, 0, 0});
-            return;
+            return true;
         }
         const auto s = static_cast<std::uint32_t>(r_.split);
         const std::uint32_t sz = d_ == 3 ? s : 1;
@@ -323,9 +367,12 @@ private:
         auto cy = static_cast<std::uint32_t>(j / row);
         std::uint64_t pi = (j % row) / s;
         auto cx = static_cast<std::uint32_t>((j % row) % s);
+        const std::uint32_t v0 = parents_[block->parent + pi].variant;
+        std::uint32_t differ = 0;
         for (std::size_t k = 0; k < n; ++k) {
             const Pos& p = parents_[block->parent + pi];
             out[k] = {p.ix * s + cx, p.iy * s + cy, p.iz * sz + block->cz, p.variant};
+            differ |= p.variant ^ v0;
             if (++cx < s) continue;
             cx = 0;
             if (++pi < block->count) continue;
@@ -334,6 +381,7 @@ private:
             cy = 0;
             ++block;
         }
+        return differ == 0;
     }
 
     // Evaluates cells [first, first + m) of the level and classifies them. With several threads the
@@ -427,11 +475,9 @@ private:
     // Sizes a batch for cells [first, first + m) and cuts it into up to chunks_per_thread chunks per
     // thread.
     void prepare(Batch& b, std::uint64_t first, std::size_t m) {
-        const auto d = static_cast<std::size_t>(d_);
         b.first = first;
         b.cells.resize(m);
-        b.boxes.resize(m * d);
-        b.out.resize(m);
+        b.verdicts.resize(m);
         b.undecided.resize(m);
         if (r_.options.keep_cells) b.kept.resize(m);
         if (prune_in_chunks_) b.pruned.assign(m, nullptr);
@@ -448,83 +494,93 @@ private:
     // different numbers of terms in different cells). Its cells are evaluated with one call per variant
     // they use. Results go by position, so the output does not depend on which thread did what.
     void run_chunk(Batch& b, Chunk& c, std::size_t worker) const {
-        const auto d = static_cast<std::size_t>(d_);
         const std::size_t n = c.end - c.begin;
-        children(b.first + c.begin, n, &b.cells[c.begin]);
-        {
-            num::UpwardRounding up; // the cell boxes use the numeric core's directed rounding
-            for (std::size_t i = c.begin; i < c.end; ++i) cell_box(b.cells[i], &b.boxes[i * d]);
-        }
-        const std::uint32_t v0 = b.cells[c.begin].variant;
-        bool one_variant = true;
-        for (std::size_t i = c.begin; i < c.end && one_variant; ++i) one_variant = b.cells[i].variant == v0;
+        const bool one_variant = children(b.first + c.begin, n, &b.cells[c.begin]);
+        c.pruned_cells = 0;
+        c.instructions = 0; // integers: the sum is exact in any order
         if (one_variant) {
-            evaluate_run(level_variants_[v0], worker, &b.boxes[c.begin * d], n, &b.out[c.begin], b, nullptr,
-                         c.begin);
+            evaluate_run(b.cells[c.begin].variant, worker, &b.cells[c.begin], n, &b.verdicts[c.begin], b,
+                         nullptr, c.begin, c);
         } else {
-            thread_local ChunkScratch s;
+            ChunkScratch& s = scratch();
             s.order.resize(n);
             for (std::size_t i = 0; i < n; ++i) s.order[i] = static_cast<std::uint32_t>(c.begin + i);
             std::stable_sort(s.order.begin(), s.order.end(), [&](std::uint32_t x, std::uint32_t y) {
                 return b.cells[x].variant < b.cells[y].variant;
             });
-            s.boxes.resize(n * d);
-            s.out.resize(n);
-            for (std::size_t i = 0; i < n; ++i) std::copy_n(&b.boxes[s.order[i] * d], d, &s.boxes[i * d]);
+            s.cells.resize(n);
+            s.verdicts.resize(n);
+            for (std::size_t i = 0; i < n; ++i) s.cells[i] = b.cells[s.order[i]];
             for (std::size_t run = 0; run < n;) {
-                const std::uint32_t v = b.cells[s.order[run]].variant;
+                const std::uint32_t v = s.cells[run].variant;
                 std::size_t end = run;
-                while (end < n && b.cells[s.order[end]].variant == v) ++end;
-                evaluate_run(level_variants_[v], worker, &s.boxes[run * d], end - run, &s.out[run], b,
-                             &s.order[run], 0);
+                while (end < n && s.cells[end].variant == v) ++end;
+                evaluate_run(v, worker, &s.cells[run], end - run, &s.verdicts[run], b, &s.order[run], 0, c);
                 run = end;
             }
-            for (std::size_t i = 0; i < n; ++i) b.out[s.order[i]] = s.out[i];
+            for (std::size_t i = 0; i < n; ++i) b.verdicts[s.order[i]] = s.verdicts[i];
         }
-        // Verdicts, counts, kept cells and the undecided ones, in order: taking them is then a few copies.
+        // Counts, kept cells and the undecided ones, in order: taking them is then a few copies.
+        std::uint32_t* undecided = &b.undecided[c.begin];
+        std::size_t u = 0, inside = 0;
+        for (std::size_t i = c.begin; i < c.end; ++i) {
+            const CellVerdict v = b.verdicts[i];
+            undecided[u] = static_cast<std::uint32_t>(i); // kept when the cell is undecided
+            u += v == CellVerdict::undecided;
+            inside += v == CellVerdict::inside;
+        }
+        c.inside = inside;
+        c.undecided = u;
+        c.outside = n - u - inside;
+        if (!r_.options.keep_cells) return;
         const bool last = level_ == r_.depth;
-        c.inside = c.outside = c.undecided = c.pruned_cells = 0;
-        c.instructions = 0;
         for (std::size_t i = c.begin; i < c.end; ++i) {
             const Pos& p = b.cells[i];
-            const Verdict v = classify(b.out[i], r_.options.closed_inside);
-            c.pruned_cells += p.variant != 0;
-            c.instructions += level_variants_[p.variant].instructions;
-            CellClass cls = CellClass::boundary;
-            if (v == Verdict::inside) {
-                cls = CellClass::inside;
-                ++c.inside;
-            } else if (v == Verdict::outside) {
-                cls = CellClass::outside;
-                ++c.outside;
-            } else {
-                if (!last) cls = CellClass::subdivided;
-                b.undecided[c.begin + c.undecided++] = static_cast<std::uint32_t>(i);
-            }
-            if (r_.options.keep_cells) b.kept[i] = {static_cast<std::uint8_t>(level_), cls, p.ix, p.iy, p.iz};
+            const CellVerdict v = b.verdicts[i];
+            const CellClass cls = v == CellVerdict::inside    ? CellClass::inside
+                                  : v == CellVerdict::outside ? CellClass::outside
+                                  : last                      ? CellClass::boundary
+                                                              : CellClass::subdivided;
+            b.kept[i] = {static_cast<std::uint8_t>(level_), cls, p.ix, p.iy, p.iz};
         }
     }
 
-    // Evaluates n boxes of one variant into out. A variant that prunes in the chunks evaluates them in
-    // batches of the boxes whose values it keeps, and an undecided cell asks for its pruned function
-    // from the values its evaluation left (Evaluator::specialize_after_eval: no second evaluation).
-    // Cell k of the run is cell index[k] (or first + k) of the batch.
-    void evaluate_run(const LevelVariant& v, std::size_t worker, const Interval* boxes, std::size_t n,
-                      Interval* out, Batch& b, const std::uint32_t* index, std::size_t first) const {
+    // Verdicts of n cells of variant `variant`, counted into the chunk. With the level's grid table and
+    // no pruning in the chunks, the evaluator builds the boxes and classifies (Evaluator::eval_cells).
+    // Else the boxes are built here; a variant that prunes in the chunks evaluates them in batches of
+    // the boxes whose values it keeps, and an undecided cell asks for its pruned function from the values
+    // its evaluation left (Evaluator::specialize_after_eval: no second evaluation). Cell k of the run is
+    // cell index[k] (or first + k) of the batch.
+    void evaluate_run(std::uint32_t variant, std::size_t worker, const Pos* cells, std::size_t n,
+                      CellVerdict* verdicts, Batch& b, const std::uint32_t* index, std::size_t first,
+                      Chunk& c) const {
+        const LevelVariant& v = level_variants_[variant];
+        c.instructions += static_cast<double>(n) * v.instructions;
+        if (variant != 0) c.pruned_cells += n;
         ir::Evaluator& e = *v.workers[worker];
-        if (!v.prune) {
-            e.eval_boxes(boxes, n, out);
+        const bool closed = r_.options.closed_inside;
+        if (table_ && !v.prune) {
+            e.eval_cells(grid_, &cells->ix, pos_stride, n, verdicts, closed);
             return;
         }
         const auto d = static_cast<std::size_t>(d_);
-        const std::size_t group = std::max<std::size_t>(e.kept_evaluations(), 1);
+        const std::size_t group = v.prune ? std::max<std::size_t>(e.kept_evaluations(), 1) : n;
+        ChunkScratch& s = scratch();
+        s.boxes.resize(std::min(group, n) * d);
+        s.out.resize(std::min(group, n));
         for (std::size_t k = 0; k < n; k += group) {
             const std::size_t m = std::min(group, n - k);
-            e.eval_boxes(boxes + k * d, m, out + k);
-            for (std::size_t j = 0; j < m; ++j)
-                if (classify(out[k + j], r_.options.closed_inside) == Verdict::undecided)
+            {
+                num::UpwardRounding up; // the cell boxes use the numeric core's directed rounding
+                for (std::size_t j = 0; j < m; ++j) cell_box(cells[k + j], &s.boxes[j * d]);
+            }
+            e.eval_boxes(s.boxes.data(), m, s.out.data());
+            for (std::size_t j = 0; j < m; ++j) {
+                verdicts[k + j] = classify(s.out[j], closed);
+                if (v.prune && verdicts[k + j] == CellVerdict::undecided)
                     b.pruned[index ? index[k + j] : first + k + j] =
-                        e.specialize_after_eval(j, boxes + (k + j) * d, expected_descendants_);
+                        e.specialize_after_eval(j, &s.boxes[j * d], expected_descendants_);
+            }
         }
     }
 
@@ -632,10 +688,12 @@ private:
     std::size_t created_ = 0; // pruned functions made (variants after the first)
     std::size_t flush_at_ = 0;
     int level_ = 0;
-    std::uint64_t n_ = 1;                     // cells per axis at level_
-    std::vector<std::vector<Interval>> grid_; // grid points of the level per axis, when n_ <= limit
-    std::vector<Interval> width_;             // enclosure of the root's width per axis
-    Batch batches_[2];                        // one filling, the other maybe evaluating
+    std::uint64_t n_ = 1;          // cells per axis at level_
+    bool table_ = false;           // n_ <= grid_table_limit: the level's cells in grid_
+    ir::CellGrid grid_;            // the level's cells per axis (when table_)
+    std::vector<Interval> points_; // ... computed from its grid points
+    std::vector<Interval> width_;  // enclosure of the root's width per axis
+    Batch batches_[2];             // one filling, the other maybe evaluating
     int filling_ = 0;
     std::vector<ChildBlock> blocks_; // the order of the level's cells (plan_children)
     std::uint64_t level_cells_ = 0;  // ... and their number

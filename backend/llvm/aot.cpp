@@ -98,6 +98,7 @@ void add_wrappers(llvm::Module& m, const AotShape& shape, const AotConfig& confi
     llvm::Function* box_fn = m.getFunction(names.box);
     llvm::Function* point_fn = m.getFunction(names.point);
     box_fn->setLinkage(llvm::GlobalValue::InternalLinkage);
+    m.getFunction(names.cells)->setLinkage(llvm::GlobalValue::InternalLinkage); // unused by the C ABI
     point_fn->setLinkage(llvm::GlobalValue::InternalLinkage);
     llvm::FunctionCallee eval_boxes = m.getOrInsertFunction(
         "frac_aot_eval_boxes", llvm::FunctionType::get(vd, {ptr, i64, ptr, i64, ptr}, false));

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <tuple>
 
 namespace frac::jit::box {
@@ -40,16 +41,47 @@ void BoxGen::allocate() {
         esc_out_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(4 * w_)), "eout");
         esc_h_ = aligned(llvm::ArrayType::get(dbl_, static_cast<std::uint64_t>(w_)), "eh");
     }
+    // The cells' parameters (CellArgs, codegen.hpp), loaded once when there are cells.
+    Value* args = fn_->getArg(4);
+    is_cells_ = b_.CreateICmpNE(args, llvm::ConstantPointerNull::get(llvm::cast<llvm::PointerType>(ptr_)));
+    BasicBlock* from = b_.GetInsertBlock();
+    BasicBlock* load = BasicBlock::Create(ctx_, "cells.args", fn_);
+    BasicBlock* go = BasicBlock::Create(ctx_, "cells.go", fn_);
+    b_.CreateCondBr(is_cells_, load, go);
+    b_.SetInsertPoint(load);
+    static_assert(offsetof(CellArgs, coords) == 3 * 8 && offsetof(CellArgs, stride) == 4 * 8 &&
+                  offsetof(CellArgs, closed_inside) == 5 * 8 && sizeof(CellArgs) == 6 * 8);
+    auto field = [&](Type* t, std::uint64_t k) {
+        return b_.CreateLoad(t, b_.CreateInBoundsGEP(i64_, args, b_.getInt64(k)));
+    };
+    const auto d = static_cast<std::size_t>(std::min(t_.inputs, 3));
+    std::vector<Value*> loaded;
+    for (std::size_t a = 0; a < d; ++a) loaded.push_back(field(ptr_, a));
+    loaded.push_back(field(ptr_, 3));
+    loaded.push_back(field(i64_, 4));
+    loaded.push_back(b_.CreateICmpNE(field(i64_, 5), b_.getInt64(0)));
+    b_.CreateBr(go);
+    b_.SetInsertPoint(go);
+    auto merged = [&](Value* v) {
+        llvm::PHINode* p = b_.CreatePHI(v->getType(), 2);
+        p->addIncoming(llvm::Constant::getNullValue(v->getType()), from);
+        p->addIncoming(v, load);
+        return p;
+    };
+    for (std::size_t a = 0; a < d; ++a) cell_axis_[a] = merged(loaded[a]);
+    cell_coords_ = merged(loaded[d]);
+    cell_stride_ = merged(loaded[d + 1]);
+    cell_closed_ = merged(loaded[d + 2]);
 }
 
 // One iteration per group of W boxes; lanes past the end repeat the last box and are not stored.
 void BoxGen::load_inputs(Value* in, Value* n, Value* k) {
     first_box_ = b_.CreateMul(k, b_.getInt64(static_cast<std::uint64_t>(w_)));
     Value* last_box = b_.CreateSub(n, b_.getInt64(1));
-    std::vector<Value*> box_of_lane(static_cast<std::size_t>(w_));
+    box_of_lane_.assign(static_cast<std::size_t>(w_), nullptr);
     for (int j = 0; j < w_; ++j) {
         Value* bj = b_.CreateAdd(first_box_, b_.getInt64(static_cast<std::uint64_t>(j)));
-        box_of_lane[static_cast<std::size_t>(j)] =
+        box_of_lane_[static_cast<std::size_t>(j)] =
             j == 0 ? bj : b_.CreateSelect(b_.CreateICmpULT(bj, n), bj, last_box);
     }
     if (w_ == 1) {
@@ -59,28 +91,95 @@ void BoxGen::load_inputs(Value* in, Value* n, Value* k) {
             b_.CreateAdd(b_.CreateVectorSplat(static_cast<unsigned>(w_), first_box_), lane_numbers());
         ctx_mask_ = b_.CreateICmpULT(lanes, b_.CreateVectorSplat(static_cast<unsigned>(w_), n));
     }
-    const auto d = static_cast<std::uint64_t>(t_.inputs);
-    for (std::size_t j = 0; j < t_.input_slots.size(); ++j) {
+    lanes_mask_ = ctx_mask_;
+    BasicBlock* boxes = BasicBlock::Create(ctx_, "load.boxes", fn_);
+    BasicBlock* cells = BasicBlock::Create(ctx_, "load.cells", fn_);
+    BasicBlock* join = BasicBlock::Create(ctx_, "load.join", fn_);
+    b_.CreateCondBr(is_cells_, cells, boxes);
+    const std::size_t inputs = t_.input_slots.size();
+    std::vector<IV> from_boxes(inputs), from_cells(inputs);
+    b_.SetInsertPoint(boxes);
+    for (std::size_t j = 0; j < inputs; ++j)
+        if (t_.input_slots[j] != ir::no_slot) from_boxes[j] = box_input(in, j);
+    b_.CreateBr(join);
+    b_.SetInsertPoint(cells);
+    for (std::size_t j = 0; j < inputs; ++j)
+        if (t_.input_slots[j] != ir::no_slot) from_cells[j] = cell_input(j);
+    b_.CreateBr(join);
+    b_.SetInsertPoint(join);
+    for (std::size_t j = 0; j < inputs; ++j) {
         const Slot s = t_.input_slots[j];
         if (s == ir::no_slot) continue;
         SlotState& st = vals_[s];
         for (int half = 0; half < 2; ++half) {
-            Value* v = w_ == 1 ? nullptr : static_cast<Value*>(llvm::PoisonValue::get(vt_));
-            for (int l = 0; l < w_; ++l) {
-                Value* at =
-                    b_.CreateAdd(b_.CreateMul(box_of_lane[static_cast<std::size_t>(l)], b_.getInt64(2 * d)),
-                                 b_.getInt64(2 * j + static_cast<std::uint64_t>(half)));
-                Value* x = b_.CreateLoad(dbl_, b_.CreateInBoundsGEP(dbl_, in, at));
-                v = w_ == 1 ? x : b_.CreateInsertElement(v, x, b_.getInt64(static_cast<std::uint64_t>(l)));
-            }
-            (half ? st.v.hi : st.v.lo) = v;
+            llvm::PHINode* p = b_.CreatePHI(vt_, 2, half ? "in.hi" : "in.lo");
+            p->addIncoming(half ? from_boxes[j].hi : from_boxes[j].lo, boxes);
+            p->addIncoming(half ? from_cells[j].hi : from_cells[j].lo, cells);
+            (half ? st.v.hi : st.v.lo) = p;
         }
         st.f = tab_.slot_facts[s]; // not empty: boxes with an empty coordinate go to the interpreter
     }
 }
 
+IV BoxGen::box_input(Value* in, std::size_t j) {
+    const auto d = static_cast<std::uint64_t>(t_.inputs);
+    IV r;
+    for (int half = 0; half < 2; ++half) {
+        Value* v = w_ == 1 ? nullptr : static_cast<Value*>(llvm::PoisonValue::get(vt_));
+        for (int l = 0; l < w_; ++l) {
+            Value* at =
+                b_.CreateAdd(b_.CreateMul(box_of_lane_[static_cast<std::size_t>(l)], b_.getInt64(2 * d)),
+                             b_.getInt64(2 * j + static_cast<std::uint64_t>(half)));
+            Value* x = b_.CreateLoad(dbl_, b_.CreateInBoundsGEP(dbl_, in, at));
+            v = w_ == 1 ? x : b_.CreateInsertElement(v, x, b_.getInt64(static_cast<std::uint64_t>(l)));
+        }
+        (half ? r.hi : r.lo) = v;
+    }
+    return r;
+}
+
+// The cell's interval along axis j: entry coords[box * stride + j] of the axis's table. A tape of more
+// than 3 inputs is never called with cells (a grid has at most 3 axes, and eval_cells checks that it
+// has as many as the tape has inputs): its cell code is a placeholder.
+IV BoxGen::cell_input(std::size_t j) {
+    if (j >= 3) return {cst(0.0), cst(0.0)};
+    IV r;
+    if (w_ > 1) r = {llvm::PoisonValue::get(vt_), llvm::PoisonValue::get(vt_)};
+    for (int l = 0; l < w_; ++l) {
+        Value* at = b_.CreateAdd(b_.CreateMul(box_of_lane_[static_cast<std::size_t>(l)], cell_stride_),
+                                 b_.getInt64(j));
+        Value* c = b_.CreateZExt(b_.CreateLoad(i32_, b_.CreateInBoundsGEP(i32_, cell_coords_, at)), i64_);
+        Value* entry = b_.CreateInBoundsGEP(dbl_, cell_axis_[j], b_.CreateMul(c, b_.getInt64(2)));
+        Value* lo = b_.CreateLoad(dbl_, entry);
+        Value* hi = b_.CreateLoad(dbl_, b_.CreateInBoundsGEP(dbl_, entry, b_.getInt64(1)));
+        if (w_ == 1) return {lo, hi};
+        r.lo = b_.CreateInsertElement(r.lo, lo, b_.getInt64(static_cast<std::uint64_t>(l)));
+        r.hi = b_.CreateInsertElement(r.hi, hi, b_.getInt64(static_cast<std::uint64_t>(l)));
+    }
+    return r;
+}
+
+Value* BoxGen::verdict(const IV& r) {
+    Type* bytes = w_ == 1 ? static_cast<Type*>(b_.getInt8Ty())
+                          : llvm::FixedVectorType::get(b_.getInt8Ty(), static_cast<unsigned>(w_));
+    auto as_byte = [&](ir::CellVerdict v) {
+        return llvm::ConstantInt::get(bytes, static_cast<std::uint64_t>(v));
+    };
+    Value* inside = lor(lt(r.hi, cst(0.0)), land(splat(cell_closed_), le(r.hi, cst(0.0))));
+    Value* v =
+        sel(gt(r.lo, cst(0.0)), as_byte(ir::CellVerdict::outside), as_byte(ir::CellVerdict::undecided));
+    v = sel(inside, as_byte(ir::CellVerdict::inside), v);
+    v = sel(gt(r.lo, r.hi), as_byte(ir::CellVerdict::outside), v); // empty: f undefined on the box
+    return sel(cmp(llvm::CmpInst::FCMP_UNO, r.lo, r.hi), as_byte(ir::CellVerdict::undecided), v);
+}
+
 void BoxGen::store_result(Value* out, Value* n, Value*) {
     const IV r = vals_[t_.result].v;
+    BasicBlock* boxes = BasicBlock::Create(ctx_, "store.boxes", fn_);
+    BasicBlock* cells = BasicBlock::Create(ctx_, "store.cells", fn_);
+    BasicBlock* join = BasicBlock::Create(ctx_, "store.join", fn_);
+    b_.CreateCondBr(is_cells_, cells, boxes);
+    b_.SetInsertPoint(boxes);
     for (int l = 0; l < w_; ++l) {
         Value* bj = b_.CreateAdd(first_box_, b_.getInt64(static_cast<std::uint64_t>(l)));
         Value* at = b_.CreateInBoundsGEP(dbl_, out, b_.CreateMul(bj, b_.getInt64(2)));
@@ -88,6 +187,15 @@ void BoxGen::store_result(Value* out, Value* n, Value*) {
         b_.CreateStore(lane(r.lo, l), at);
         b_.CreateStore(lane(r.hi, l), b_.CreateInBoundsGEP(dbl_, at, b_.getInt64(1)));
     }
+    b_.CreateBr(join);
+    b_.SetInsertPoint(cells);
+    Value* at = b_.CreateInBoundsGEP(b_.getInt8Ty(), out, first_box_);
+    if (w_ == 1)
+        b_.CreateStore(verdict(r), at);
+    else
+        b_.CreateMaskedStore(verdict(r), at, llvm::Align(1), lanes_mask_);
+    b_.CreateBr(join);
+    b_.SetInsertPoint(join);
 }
 
 SlotState BoxGen::constant(const ir::TapeConst& c) {
@@ -328,10 +436,35 @@ SlotState BoxGen::emit_series(const Instr& ins) {
 
 namespace frac::jit {
 
-std::string generate_box_function(const ir::Tape& tape, const ir::EvalOptions& options, const Tables& tables,
-                                  llvm::Module& module, const std::string& name, Rounding rounding,
-                                  int lanes) {
-    return box::BoxGen(tape, options, tables, module, name, rounding, lanes).run("_box", "boxes");
+void generate_box_functions(const ir::Tape& tape, const ir::EvalOptions& options, const Tables& tables,
+                            llvm::Module& module, const std::string& name, Rounding rounding, int lanes,
+                            GeneratedNames& names) {
+    const std::string body_name = box::BoxGen(tape, options, tables, module, name, rounding, lanes)
+                                      .run("_box.body", "boxes", true, llvm::GlobalValue::InternalLinkage);
+    llvm::Function* body = module.getFunction(body_name);
+    llvm::LLVMContext& ctx = module.getContext();
+    auto* ptr = llvm::PointerType::get(ctx, 0);
+    auto* i64 = llvm::Type::getInt64Ty(ctx);
+    const std::vector<llvm::Type*> params{ptr, i64, ptr, ptr};
+    auto* fty = llvm::FunctionType::get(llvm::Type::getVoidTy(ctx), params, false);
+    // (in, n, out, stats) -> the body with the cells' parameters last (null for boxes).
+    auto entry = [&](const char* suffix, bool cells) {
+        llvm::Function* f =
+            llvm::Function::Create(fty, llvm::GlobalValue::ExternalLinkage, name + suffix, module);
+        f->setDoesNotThrow();
+        const bool strict = rounding != Rounding::avx512; // box::BoxGen::prepare
+        if (strict) f->addFnAttr(llvm::Attribute::StrictFP);
+        llvm::IRBuilder<> b(llvm::BasicBlock::Create(ctx, "entry", f));
+        llvm::Value* none = llvm::ConstantPointerNull::get(ptr);
+        llvm::CallInst* call =
+            cells ? b.CreateCall(body, {none, f->getArg(1), f->getArg(2), f->getArg(3), f->getArg(0)})
+                  : b.CreateCall(body, {f->getArg(0), f->getArg(1), f->getArg(2), f->getArg(3), none});
+        if (strict) call->addFnAttr(llvm::Attribute::StrictFP);
+        b.CreateRetVoid();
+        return f->getName().str();
+    };
+    names.box = entry("_box", false);
+    names.cells = entry("_cells", true);
 }
 
 } // namespace frac::jit

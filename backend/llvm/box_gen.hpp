@@ -99,8 +99,16 @@ private:
     void prepare(Function* f);
     void allocate();
     // One iteration per group of W boxes; lanes past the end repeat the last box and are not stored.
+    // The boxes come from `in`, or, when the fifth parameter (CellArgs) is not null, from the cells'
+    // coordinates and the grid's tables; the results go to `out` as intervals, or as the cells'
+    // verdicts (ir::classify).
     void load_inputs(Value* in, Value* n, Value* k);
     void store_result(Value* out, Value* n, Value*);
+    // Input j of the iteration's boxes, from `in` / from the cells.
+    IV box_input(Value* in, std::size_t j);
+    IV cell_input(std::size_t j);
+    // ir::classify of each lane's enclosure: ir::CellVerdict as a byte.
+    Value* verdict(const IV& r);
     SlotState constant(const ir::TapeConst& c);
     SlotState indexed(const IndexTable& it, Value* idx);
     SlotState operation(const Instr& ins);
@@ -423,8 +431,17 @@ private:
     Value* esc_out_ = nullptr;
     Value* esc_h_ = nullptr;
     Value* sink_ = nullptr;
-    Value* first_box_ = nullptr; // the iteration's first box
-    Value* ctx_mask_ = nullptr;  // lanes the current code computes for
+    Value* first_box_ = nullptr;      // the iteration's first box
+    std::vector<Value*> box_of_lane_; // ... and each lane's (lanes past the end: the last one)
+    Value* lanes_mask_ = nullptr;     // the lanes holding boxes of the batch
+    // Cells (CellArgs, loaded once in the entry block): whether there are, the tables per axis, the
+    // coordinates, their stride, the closed-inside rule (i1).
+    Value* is_cells_ = nullptr;
+    Value* cell_axis_[3] = {nullptr, nullptr, nullptr};
+    Value* cell_coords_ = nullptr;
+    Value* cell_stride_ = nullptr;
+    Value* cell_closed_ = nullptr;
+    Value* ctx_mask_ = nullptr; // lanes the current code computes for
 };
 
 } // namespace frac::jit::box

@@ -248,7 +248,7 @@ std::string external_getter(const std::string& name, std::int64_t k) {
 GeneratedNames generate(const Tape& tape, const ir::EvalOptions& options, const Tables& tables,
                         llvm::Module& module, const std::string& name, Rounding rounding, int lanes) {
     GeneratedNames names;
-    names.box = generate_box_function(tape, options, tables, module, name, rounding, lanes);
+    generate_box_functions(tape, options, tables, module, name, rounding, lanes, names);
     names.point = PointGen(tape, options, tables, module, name).run("_point", "point");
     return names;
 }

@@ -32,8 +32,20 @@ namespace frac::jit {
 // or AVX-512 instructions with embedded rounding ({ru-sae}) where the host has them.
 enum class Rounding { constrained, avx512 };
 
+// Two entry points share the box code: <name>_box (above), and
+//   void <name>_cells(const CellArgs* cells, i64 n, u8* verdicts, u64* stats)
+//     the n cells' boxes from their integer coordinates and the grid's tables, each evaluated as
+//     <name>_box evaluates a box, and its verdict (ir::CellVerdict, ir::classify) stored. The caller
+//     holds upward rounding and passes in-range coordinates and tables of non-empty intervals.
+struct CellArgs {
+    const double* axis[3];       // per axis: the cells' intervals (lo, hi), ir::CellGrid::axis
+    const std::uint32_t* coords; // cell k, axis a: coords[k * stride + a]
+    std::int64_t stride;         // >= the tape's inputs
+    std::int64_t closed_inside;  // 1: hi <= 0 is inside (ir::classify)
+};
+
 struct GeneratedNames {
-    std::string box, point;
+    std::string box, point, cells;
 };
 
 // The tape's external function k (Op::External) is called through a pointer: the JIT embeds the

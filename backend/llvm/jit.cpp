@@ -38,6 +38,9 @@ double ms_since(Clock::time_point t0) {
 // The generated batch functions (codegen.hpp).
 using BatchBoxes = void (*)(const double* boxes, std::int64_t n, double* out, std::uint64_t* stats);
 using BatchPoints = void (*)(const double* coords, std::int64_t n, double* out, std::uint64_t* stats);
+using BatchCells = void (*)(const CellArgs* cells, std::int64_t n, std::uint8_t* verdicts,
+                            std::uint64_t* stats);
+static_assert(sizeof(ir::CellVerdict) == 1);
 
 static_assert(sizeof(ir::EvalStats) == 3 * sizeof(std::uint64_t));
 static_assert(offsetof(ir::EvalStats, calls) == 0 && offsetof(ir::EvalStats, series_terms) == 8 &&
@@ -179,6 +182,7 @@ struct Compiled {
     bool has_choices = false; // block 0 has min/max/select instructions to prune
     BatchBoxes boxes = nullptr;
     BatchPoints points = nullptr;
+    BatchCells cells = nullptr;
     // Each tape's code is linked into its own library, so that every module can use the same symbol
     // names: its object is then the same in every process, and can be cached.
     llvm::orc::JITDylib* dylib = nullptr;
@@ -268,6 +272,26 @@ public:
             }
             i = j;
         }
+    }
+
+    // The boxes from the grid's tables and the verdicts in the generated code: no boxes in memory, no
+    // test of each box for empty coordinates (a grid knows whether its tables are non-empty).
+    void eval_cells(const ir::CellGrid& grid, const std::uint32_t* coords, std::size_t stride, std::size_t n,
+                    ir::CellVerdict* out, bool closed_inside) override {
+        if (!grid.nonempty()) {
+            Evaluator::eval_cells(grid, coords, stride, n, out, closed_inside);
+            return;
+        }
+        grid.check(dimension(), coords, stride, n);
+        if (n == 0) return;
+        CellArgs args{};
+        for (int a = 0; a < grid.dimension(); ++a)
+            args.axis[a] = reinterpret_cast<const double*>(grid.axis(a));
+        args.coords = coords;
+        args.stride = static_cast<std::int64_t>(stride);
+        args.closed_inside = closed_inside ? 1 : 0;
+        num::UpwardRounding up;
+        code_->cells(&args, static_cast<std::int64_t>(n), reinterpret_cast<std::uint8_t*>(out), counters());
     }
 
     const CompileInfo& info() const { return code_->info; }
@@ -379,7 +403,10 @@ std::shared_ptr<const Compiled> compile(const ir::Tape& tape, const ir::EvalOpti
     if (!box) throw JitError("the LLVM JIT could not link a shape: " + to_string(box.takeError()));
     auto point = engine->jit->lookup(*dylib, g.names.point);
     if (!point) throw JitError("the LLVM JIT could not compile a shape: " + to_string(point.takeError()));
+    auto cells = engine->jit->lookup(*dylib, g.names.cells);
+    if (!cells) throw JitError("the LLVM JIT could not link a shape: " + to_string(cells.takeError()));
     code->boxes = box->toPtr<BatchBoxes>();
+    code->cells = cells->toPtr<BatchCells>();
     code->points = point->toPtr<BatchPoints>();
     info.machine_ms += ms_since(t);
     info.total_ms = ms_since(t0);

@@ -48,17 +48,23 @@ public:
     }
 
     // void <name><suffix>(const double* in, i64 n, double* out, u64* stats): a loop over the batch,
-    // w_ points or boxes an iteration; stats gets n, the terms and the capped series.
-    std::string run(const char* suffix, const char* loop_name) {
+    // w_ points or boxes an iteration; stats gets n, the terms and the capped series. With `args`, a
+    // fifth parameter, a read-only pointer the generator reads (fn_->getArg(4)).
+    std::string run(const char* suffix, const char* loop_name, bool args = false,
+                    llvm::GlobalValue::LinkageTypes linkage = llvm::GlobalValue::ExternalLinkage) {
         const std::string fname = name_ + suffix;
-        auto* fty = llvm::FunctionType::get(llvm::Type::getVoidTy(ctx_), {ptr_, i64_, ptr_, ptr_}, false);
-        llvm::Function* f = llvm::Function::Create(fty, llvm::GlobalValue::ExternalLinkage, fname, m_);
+        std::vector<llvm::Type*> params{ptr_, i64_, ptr_, ptr_};
+        if (args) params.push_back(ptr_);
+        auto* fty = llvm::FunctionType::get(llvm::Type::getVoidTy(ctx_), params, false);
+        llvm::Function* f = llvm::Function::Create(fty, linkage, fname, m_);
         f->setDoesNotThrow();
-        for (unsigned k : {0u, 2u, 3u}) {
+        for (unsigned k : {0u, 2u, 3u, 4u}) {
+            if (k >= params.size()) continue;
             f->addParamAttr(k, llvm::Attribute::NoAlias);
             f->addParamAttr(k, llvm::Attribute::NoCapture);
         }
         f->addParamAttr(0, llvm::Attribute::ReadOnly);
+        if (args) f->addParamAttr(4, llvm::Attribute::ReadOnly);
         gen().prepare(f);
         fn_ = f;
         llvm::Value* in = f->getArg(0);
@@ -74,12 +80,13 @@ public:
         capped_ = b_.CreateAlloca(i64_, nullptr, "capped");
         b_.CreateStore(b_.getInt64(0), terms_);
         b_.CreateStore(b_.getInt64(0), capped_);
-        gen().allocate();
+        gen().allocate(); // may end in another block than the entry
+        llvm::BasicBlock* pre = b_.GetInsertBlock();
         b_.CreateCondBr(b_.CreateICmpEQ(n, b_.getInt64(0)), done, loop);
 
         b_.SetInsertPoint(loop);
         llvm::PHINode* k = b_.CreatePHI(i64_, 2, "k");
-        k->addIncoming(b_.getInt64(0), entry);
+        k->addIncoming(b_.getInt64(0), pre);
         vals_.assign(t_.num_slots, V{});
         idx_.assign(t_.series.size(), nullptr);
         for (const ir::TapeConst& c : t_.constants) vals_[c.slot] = gen().constant(c);

@@ -297,6 +297,14 @@ public:
         });
     }
 
+    void eval_cells(const ir::CellGrid& grid, const std::uint32_t* coords, std::size_t stride, std::size_t n,
+                    ir::CellVerdict* out, bool closed_inside) override {
+        counted([&](ir::Evaluator& e) {
+            e.eval_cells(grid, coords, stride, n, out, closed_inside);
+            return 0;
+        });
+    }
+
     std::unique_ptr<ir::Evaluator> clone() const override {
         return std::make_unique<TieredEvaluator>(owner_, interp_->clone(), jit_ ? jit_->clone() : nullptr,
                                                  switch_after_);

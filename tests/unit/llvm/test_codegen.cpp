@@ -60,19 +60,26 @@ TEST_CASE("interval code rounds upward in every operation, never fast-math", "[l
                                  << config.lanes);
             for (bool optimized : {false, true}) {
                 const std::string ir = jit::emit_llvm(m.tapes[i], {}, optimized, config);
-                const std::string box = function_text(ir, "_box");
+                // The box code: the body that <name>_box and <name>_cells call.
+                const std::string box = function_text(ir, "_box.body");
                 // No fast-math flag anywhere in the module.
                 for (const char* flag :
                      {" fast ", " nnan ", " ninf ", " nsz ", " arcp ", " contract ", " afn ", " reassoc "})
                     CHECK(ir.find(flag) == std::string::npos);
                 // No rounding arithmetic that is not explicitly upward.
                 CHECK_FALSE(std::regex_search(box, plain));
-                std::smatch group;
-                REQUIRE(std::regex_search(box, group, std::regex(R"(^define[^\n]*(#[0-9]+) \{)")));
-                const std::size_t attrs = ir.find("attributes " + group[1].str() + " = {");
-                REQUIRE(attrs != std::string::npos);
-                const bool strictfp =
-                    ir.substr(attrs, ir.find('}', attrs) - attrs).find("strictfp") != std::string::npos;
+                const auto is_strictfp = [&](const std::string& function) {
+                    std::smatch group;
+                    REQUIRE(std::regex_search(function, group, std::regex(R"(^define[^\n]*(#[0-9]+) \{)")));
+                    const std::size_t attrs = ir.find("attributes " + group[1].str() + " = {");
+                    REQUIRE(attrs != std::string::npos);
+                    return ir.substr(attrs, ir.find('}', attrs) - attrs).find("strictfp") !=
+                           std::string::npos;
+                };
+                const bool strictfp = is_strictfp(box);
+                // The two entry points into the body are strictfp where it is.
+                for (const char* entry : {"_box", "_cells"})
+                    CHECK(is_strictfp(function_text(ir, entry)) == strictfp);
                 if (config.rounding == R::constrained) {
                     // strictfp, and every constrained operation says round.upward.
                     CHECK(strictfp);
