@@ -160,7 +160,7 @@ struct LanePush {
     bool too_long = false;               // the pruned code costs more than the rule allows
     std::uint32_t kept = 0;              // instructions the pruned code keeps
     std::uint32_t partial = 0;           // ... that may be undefined
-    std::vector<std::uint32_t> reversed; // the pruned code in reverse (ThreadFile)
+    std::vector<std::uint32_t> reversed; // the pruned code in reverse (ThreadFile::pushes)
     std::weak_ptr<ir::Evaluator> built;  // the evaluator of the pruned tape, once built
 };
 
@@ -176,9 +176,9 @@ struct ThreadFile {
     std::uint64_t evaluations = 0;              // box evaluations on this thread: names the last one
     // The push analysis of the last box evaluation (analyse): which evaluation, for how many
     // expected evaluations; by parent slot, the lanes whose pruned tape reads it and the lanes where
-    // it may be empty; by lane, its outcome and its pruned code in reverse (parent instruction << 2
-    // | 0 to keep it, or 1 + the operand a decided choice takes). final_slot: by parent slot, its
-    // slot in the tape being built.
+    // it may be empty (when mark_may_empty found any); by lane, its outcome and its pruned code in
+    // reverse, each entry the parent instruction's index << 2, | 0 to keep it or | 1 + the operand a
+    // decided choice takes. final_slot: by parent slot, its slot in the tape being built.
     std::uint64_t analysed = 0;
     double analysed_expected = 0;
     std::vector<std::uint8_t> lane_live, lane_empty;
