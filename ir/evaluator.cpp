@@ -6,6 +6,19 @@
 
 namespace frac::ir {
 
+namespace {
+
+// most[a] = the largest of coords[k * stride + a] over k < n, a < D.
+template <int D>
+void largest(const std::uint32_t* coords, std::size_t stride, std::size_t n, std::uint32_t* most) {
+    std::uint32_t m[D] = {};
+    for (std::size_t k = 0; k < n; ++k, coords += stride)
+        for (int a = 0; a < D; ++a) m[a] = std::max(m[a], coords[a]);
+    std::copy_n(m, D, most);
+}
+
+} // namespace
+
 void CellGrid::check_shape(int dimension, const std::uint64_t* cells) {
     if (dimension < 1 || dimension > 3)
         throw std::invalid_argument("cell grid: " + std::to_string(dimension) + " axes; it takes 1 to 3");
@@ -24,16 +37,12 @@ void CellGrid::check(int dimension, const std::uint32_t* coords, std::size_t str
         throw std::invalid_argument("eval_cells: stride " + std::to_string(stride) + " below the " +
                                     std::to_string(d) + " coordinates of a cell");
     if (n == 0) return;
-    // The largest coordinate per axis (a reduction the compiler vectorises: one instruction a cell for
-    // the cover's stride of 4); the cells at fault are looked for only on failure.
-    std::uint32_t most[4] = {0, 0, 0, 0};
-    if (stride == 4) {
-        for (std::size_t k = 0; k < n; ++k)
-            for (std::size_t a = 0; a < 4; ++a) most[a] = std::max(most[a], coords[4 * k + a]);
-    } else {
-        for (std::size_t a = 0; a < d; ++a)
-            for (std::size_t k = 0; k < n; ++k) most[a] = std::max(most[a], coords[k * stride + a]);
-    }
+    // The largest coordinate per axis (in registers: about a cycle a cell); the cells at fault are
+    // looked for only on failure.
+    std::uint32_t most[3] = {0, 0, 0};
+    if (d == 1) largest<1>(coords, stride, n, most);
+    if (d == 2) largest<2>(coords, stride, n, most);
+    if (d == 3) largest<3>(coords, stride, n, most);
     bool bad = false;
     for (std::size_t a = 0; a < d; ++a) bad |= most[a] >= axes_[a].size();
     if (!bad) return;
