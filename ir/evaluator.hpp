@@ -43,7 +43,7 @@ struct SpecializeStats {
     std::uint64_t unpruned = 0;   // ... where nothing could be pruned
     std::uint64_t too_little = 0; // ... where pruning saved less than the rule asks
     std::uint64_t declined = 0;   // ... where compiling would cost more than it saves (or the cache is full)
-    std::uint64_t hits = 0;       // ... answered by an already compiled specialisation
+    std::uint64_t hits = 0;       // ... answered by an existing one (compiled, or a sibling's pushed tape)
     std::uint64_t compiled = 0;   // ... that compiled a new one (machine code)
     std::uint64_t pushes = 0;     // ... that made a pruned tape the interpreter runs (no compile)
     std::uint64_t fallbacks = 0;  // ... that made a second-tier (interpreted) one, no compile
