@@ -304,6 +304,8 @@ private:
             level_variants_.push_back({v.workers.data(), prune, v.instructions});
             prune_in_chunks_ |= prune;
         }
+        // Children of pruned parents evaluate their parent's function (a variant of their own).
+        keep_siblings_ = prune_in_chunks_ || variants_.size() > 1;
         // The level's cells per axis, computed once (each cell would otherwise compute two grid points
         // per axis with three interval operations each): the same boxes as grid::cell. Evaluators build
         // the cells' boxes from it (Evaluator::eval_cells).
@@ -319,8 +321,12 @@ private:
 
     // Evaluates the level's cells, from the plan of start_level, batch by batch.
     void evaluate_level() {
-        for (std::uint64_t c = 0; c < level_cells_; c += flush_at_)
-            flush(c, static_cast<std::size_t>(std::min<std::uint64_t>(flush_at_, level_cells_ - c)));
+        for (std::uint64_t c = 0; c < level_cells_;) {
+            std::uint64_t end = std::min<std::uint64_t>(c + flush_at_, level_cells_);
+            if (keep_siblings_) end = sibling_cut(c, end);
+            flush(c, static_cast<std::size_t>(end - c));
+            c = end;
+        }
         drain();
         if (r_.options.progress) r_.options.progress(level_, r_.evaluated);
         last_progress_ = Clock::now();
@@ -348,6 +354,21 @@ private:
             slab = slab_end;
         }
         level_cells_ = first;
+    }
+
+    // Where a batch or chunk of the level's cells [begin, end) ends when they prune in the chunks or
+    // evaluate pruned functions (keep_siblings_): at the start of the block (a parent row's children)
+    // that `end` would cut, if it starts after `begin`. A parent's children then stay in one chunk, and
+    // an interpreter evaluates them side by side and analyses their tape pushes together (a block
+    // holds all of a parent's children in 2D, split^2 of them in 3D); cut between the child rows, each
+    // parent of the row would evaluate and push in two halves. A block larger than a batch is cut.
+    std::uint64_t sibling_cut(std::uint64_t begin, std::uint64_t end) const {
+        if (level_ == 0 || end >= level_cells_) return end;
+        const auto block =
+            std::upper_bound(blocks_.begin(), blocks_.end(), end,
+                             [](std::uint64_t v, const ChildBlock& b) { return v < b.first; }) -
+            1;
+        return block->first > begin ? block->first : end;
     }
 
     // Cells [c, c + n) of the level, in its order (plan_children; level 0 is the root). Returns whether
@@ -486,7 +507,14 @@ private:
             std::min<std::size_t>(threads_ == 1 ? 1 : chunks_per_thread * static_cast<std::size_t>(threads_),
                                   (m + min_chunk - 1) / min_chunk));
         b.chunks.clear();
-        for (std::size_t c = 0; c < k; ++c) b.chunks.push_back({m * c / k, m * (c + 1) / k});
+        for (std::size_t c = 0, begin = 0; c < k; ++c) {
+            std::size_t end = m * (c + 1) / k;
+            if (keep_siblings_ && c + 1 < k)
+                end = static_cast<std::size_t>(sibling_cut(first + begin, first + end) - first);
+            if (end == begin) continue;
+            b.chunks.push_back({begin, end});
+            begin = end;
+        }
     }
 
     // A chunk runs on the evaluators of the thread that takes it (its slot in the arena), so no two
@@ -685,7 +713,8 @@ private:
     // each with an evaluator per thread.
     std::vector<Variant> variants_;
     std::unordered_map<const ir::Evaluator*, std::uint32_t> variant_of_;
-    std::size_t created_ = 0; // pruned functions made (variants after the first)
+    std::size_t created_ = 0;    // pruned functions made (variants after the first)
+    bool keep_siblings_ = false; // cut batches and chunks between parents (sibling_cut)
     std::size_t flush_at_ = 0;
     int level_ = 0;
     std::uint64_t n_ = 1;          // cells per axis at level_

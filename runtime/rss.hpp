@@ -47,10 +47,12 @@ struct RssOptions {
     // The most levels allowed; 0: max_depth_2d or max_depth_3d. Above them, only split^depth <= 2^32
     // bounds it (the CLI's FRAC_MAX_DEPTH; max_cells bounds the memory).
     int max_depth = 0;
-    int split = 2;            // parts per axis and level
-    bool keep_cells = true;   // record every evaluated cell (for pictures); false keeps only counts
-    std::size_t batch = 4096; // cells per eval_boxes call (>= 1)
-    RssProgress progress;     // optional
+    int split = 2;          // parts per axis and level
+    bool keep_cells = true; // record every evaluated cell (for pictures); false keeps only counts
+    // Cells per eval_boxes call (>= 1); once cells prune, a batch ends before the children of a parent
+    // row it would cut (a parent's children stay together).
+    std::size_t batch = 4096;
+    RssProgress progress; // optional
     // Threads evaluating each batch (0: all cores). Each thread has its own clone of the evaluator,
     // and results are placed by cell position, so the output is the same for every thread count.
     int threads = 1;

@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <set>
 #include <stdexcept>
 #include <tuple>
@@ -305,6 +307,65 @@ TEST_CASE("rss: evaluates level by level in batches", "[rss]") {
     std::size_t nonempty = 0;
     for (const LevelCounts& lc : r2.levels) nonempty += lc.evaluated > 0 ? 1 : 0;
     CHECK(big.batches == nonempty); // every level fits one default batch here
+}
+
+namespace {
+
+// A disk whose every tape push (in the chunks, as the interpreter's) returns an evaluator of its own,
+// which logs the size of each of its eval_boxes calls: the children of a parent evaluated side by side
+// log one call of 4.
+class PushingDisk : public Disk {
+public:
+    struct Log {
+        std::mutex mu;
+        std::map<int, std::vector<std::size_t>> calls; // by evaluator (0: the shape's)
+        int pushed = 0;
+    };
+    PushingDisk(std::shared_ptr<Log> log, int id) : Disk(0.1, -0.2, 0.6), log(std::move(log)), id(id) {}
+    bool may_specialize() const override { return true; }
+    bool specializes_independently() const override { return true; }
+    std::size_t kept_evaluations() const override { return 4; }
+    void eval_boxes(const Interval* boxes, std::size_t n, Interval* out) override {
+        {
+            std::lock_guard<std::mutex> lock(log->mu);
+            log->calls[id].push_back(n);
+        }
+        Disk::eval_boxes(boxes, n, out);
+    }
+    std::shared_ptr<ir::Evaluator> specialize_after_eval(std::size_t, const Interval*, double) override {
+        std::lock_guard<std::mutex> lock(log->mu);
+        return std::make_shared<PushingDisk>(log, ++log->pushed);
+    }
+    std::unique_ptr<ir::Evaluator> clone() const override { return std::make_unique<PushingDisk>(log, id); }
+
+    std::shared_ptr<Log> log;
+    int id;
+};
+
+} // namespace
+
+TEST_CASE("rss: a parent's children stay in one chunk when they push tapes", "[rss]") {
+    // Batches and chunks cut the level's order (row-major: a parent's children lie in two rows); cut
+    // between those rows, its children would evaluate and push in two halves. (Batches at least as
+    // large as a parent row's children: a smaller one cannot help cutting them.)
+    for (const std::size_t batch : {std::size_t{300}, std::size_t{1000}, std::size_t{4096}}) {
+        for (const int threads : {1, 2}) {
+            auto log = std::make_shared<PushingDisk::Log>();
+            PushingDisk disk(log, 0);
+            RssOptions o = opts(7);
+            o.batch = batch;
+            o.threads = threads;
+            const RssResult r = subdivide(disk, square, o);
+            check_consistency(r);
+            INFO("batch " << batch << ", " << threads << " threads");
+            REQUIRE(log->pushed > 300);
+            for (const auto& [id, calls] : log->calls) {
+                if (id == 0) continue;
+                INFO("pushed evaluator " << id);
+                REQUIRE(calls == std::vector<std::size_t>{4});
+            }
+        }
+    }
 }
 
 TEST_CASE("rss: progress reports each level", "[rss]") {
