@@ -20,10 +20,20 @@ Interval point(Interval axis, Interval w, std::uint64_t j, std::uint64_t n) {
     return num::add(Interval(axis.lo), t);
 }
 
+namespace {
+
+// Cell i of n along `axis`: from grid point i to grid point i + 1 (point(j) their enclosures, taken
+// outward), clamped to the axis, whose ends are exact.
+template <class Point>
+Interval cell_between(Interval axis, std::uint64_t i, std::uint64_t n, Point&& point) {
+    return {i == 0 ? axis.lo : std::max(axis.lo, point(i).lo),
+            i + 1 >= n ? axis.hi : std::min(axis.hi, point(i + 1).hi)};
+}
+
+} // namespace
+
 Interval cell(Interval axis, Interval w, std::uint64_t i, std::uint64_t n) {
-    const double lo = i == 0 ? axis.lo : std::max(axis.lo, point(axis, w, i, n).lo);
-    const double hi = i + 1 >= n ? axis.hi : std::min(axis.hi, point(axis, w, i + 1, n).hi);
-    return {lo, hi};
+    return cell_between(axis, i, n, [&](std::uint64_t j) { return point(axis, w, j, n); });
 }
 
 Interval width(Interval axis) {
@@ -42,11 +52,8 @@ void level_cells(const std::vector<Interval>& root, std::uint64_t n, ir::CellGri
     const std::uint64_t cells[3] = {n, n, n};
     out.assign(static_cast<int>(d), cells, [&](int a, std::uint64_t i) {
         const auto ax = static_cast<std::size_t>(a);
-        const Interval x = root[ax];
         const Interval* p = &points[ax * m];
-        // cell(x, w, i, n) from the points
-        return Interval{i == 0 ? x.lo : std::max(x.lo, p[i].lo),
-                        i + 1 >= n ? x.hi : std::min(x.hi, p[i + 1].hi)};
+        return cell_between(root[ax], i, n, [p](std::uint64_t j) { return p[j]; });
     });
 }
 

@@ -364,11 +364,15 @@ private:
     // parent of the row would evaluate and push in two halves. A block larger than a batch is cut.
     std::uint64_t sibling_cut(std::uint64_t begin, std::uint64_t end) const {
         if (level_ == 0 || end >= level_cells_) return end;
-        const auto block =
-            std::upper_bound(blocks_.begin(), blocks_.end(), end,
-                             [](std::uint64_t v, const ChildBlock& b) { return v < b.first; }) -
-            1;
-        return block->first > begin ? block->first : end;
+        const std::uint64_t start = block_of(end)->first;
+        return start > begin ? start : end;
+    }
+
+    // The block (plan_children) that holds cell c of the level (level >= 1).
+    std::vector<ChildBlock>::const_iterator block_of(std::uint64_t c) const {
+        return std::upper_bound(blocks_.begin(), blocks_.end(), c,
+                                [](std::uint64_t v, const ChildBlock& b) { return v < b.first; }) -
+               1;
     }
 
     // Cells [c, c + n) of the level, in its order (plan_children; level 0 is the root). Returns whether
@@ -380,9 +384,7 @@ private:
         }
         const auto s = static_cast<std::uint32_t>(r_.split);
         const std::uint32_t sz = d_ == 3 ? s : 1;
-        auto block = std::upper_bound(blocks_.begin(), blocks_.end(), c,
-                                      [](std::uint64_t v, const ChildBlock& b) { return v < b.first; }) -
-                     1;
+        auto block = block_of(c);
         // Position in the block: child row cy, parent pi of the row, child column cx; then counted on.
         const std::uint64_t j = c - block->first, row = block->count * s;
         auto cy = static_cast<std::uint32_t>(j / row);
