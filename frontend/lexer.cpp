@@ -2,7 +2,6 @@
 
 #include <cctype>
 #include <fmt/format.h>
-#include <unordered_map>
 
 namespace frac::front {
 
@@ -64,20 +63,29 @@ const char* token_name(Tok t) {
 
 namespace {
 
-const std::unordered_map<std::string, Tok>& keywords() {
-    static const std::unordered_map<std::string, Tok> k = {
+// A word's keyword, or Tok::ident. A scan of the short list: a large model's words are mostly one to
+// four letters, and most differ from every keyword in their first letter or length.
+Tok keyword_or_ident(std::string_view word) {
+    struct Keyword {
+        std::string_view text;
+        Tok kind;
+    };
+    static constexpr Keyword keywords[] = {
         {"fn", Tok::kw_fn},         {"const", Tok::kw_const},   {"let", Tok::kw_let},
         {"in", Tok::kw_in},         {"if", Tok::kw_if},         {"then", Tok::kw_then},
         {"else", Tok::kw_else},     {"and", Tok::kw_and},       {"or", Tok::kw_or},
         {"not", Tok::kw_not},       {"shape", Tok::kw_shape},   {"over", Tok::kw_over},
         {"test", Tok::kw_test},     {"expect", Tok::kw_expect}, {"within", Tok::kw_within},
         {"import", Tok::kw_import}, {"print", Tok::kw_print}};
-    return k;
+    if (word.size() < 2 || word.size() > 6) return Tok::ident;
+    for (const Keyword& k : keywords)
+        if (k.text[0] == word[0] && k.text == word) return k.kind;
+    return Tok::ident;
 }
 
 class Lexer {
 public:
-    Lexer(const std::string& text, std::uint32_t file, Diagnostics& diags)
+    Lexer(std::string_view text, std::uint32_t file, Diagnostics& diags)
         : s_(text), file_(file), diags_(diags) {}
 
     std::vector<Token> run() {
@@ -139,8 +147,7 @@ private:
         if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
             while (std::isalnum(static_cast<unsigned char>(peek())) || peek() == '_') advance();
             t.text = s_.substr(start, pos_ - start);
-            auto it = keywords().find(t.text);
-            t.kind = it == keywords().end() ? Tok::ident : it->second;
+            t.kind = keyword_or_ident(t.text);
             return true;
         }
         if (std::isdigit(static_cast<unsigned char>(c)) ||
@@ -200,7 +207,7 @@ private:
             if (s_.compare(pos_, text.size(), text) == 0) {
                 for (std::size_t k = 0; k < text.size(); ++k) advance();
                 t.kind = p.kind;
-                t.text = std::string(text);
+                t.text = text;
                 return true;
             }
         }
@@ -212,7 +219,7 @@ private:
         return false;
     }
 
-    const std::string& s_;
+    std::string_view s_;
     std::uint32_t file_;
     Diagnostics& diags_;
     std::size_t pos_ = 0;
@@ -221,7 +228,7 @@ private:
 
 } // namespace
 
-std::vector<Token> lex(const std::string& text, std::uint32_t file, Diagnostics& diags) {
+std::vector<Token> lex(std::string_view text, std::uint32_t file, Diagnostics& diags) {
     return Lexer(text, file, diags).run();
 }
 

@@ -4,6 +4,7 @@
 #include "frontend/diagnostics.hpp"
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace frac::front {
@@ -67,12 +68,13 @@ const char* token_name(Tok t);
 
 struct Token {
     Tok kind = Tok::end;
-    std::string text;
+    std::string_view text; // a view of the lexed text (a string's without its quotes)
     Location loc;
 };
 
 // Splits a file into tokens; malformed characters and unterminated strings or comments are reported
-// to `diags` and skipped.
-std::vector<Token> lex(const std::string& text, std::uint32_t file, Diagnostics& diags);
+// to `diags` and skipped. The tokens view `text`, which must outlive them (hence no temporary string).
+std::vector<Token> lex(std::string_view text, std::uint32_t file, Diagnostics& diags);
+std::vector<Token> lex(std::string&& text, std::uint32_t file, Diagnostics& diags) = delete;
 
 } // namespace frac::front

@@ -178,7 +178,7 @@ private:
     //              boundary e from v { B0 = OP; } e.B0 * v.T0 == e.T0 * e.B0; fix e.T0[r][c] = E; ... }
     Item automaton(Item it) {
         if (at_word("fif")) return fif(std::move(it));
-        const std::string word = take().text;
+        const std::string word(take().text);
         const bool graph_directed = word != "ifs";
         it.kind = ItemKind::automaton;
         it.name = expect(Tok::ident, word == "ifs"    ? "after 'ifs'"
@@ -486,7 +486,7 @@ private:
                 n.text.find_first_not_of("0123456789") != std::string::npos)
                 throw CompileError(
                     n.loc, fmt::format("a seed is a whole number of at most 18 digits, not {}", n.text));
-            b.seed = std::stoull(n.text);
+            b.seed = std::stoull(std::string(n.text));
         } else if (at_word("fix")) {
             take();
             FixDecl f;
@@ -510,7 +510,7 @@ private:
     // The number of parts of a topology: 1 to 16.
     int count() {
         const Token& n = expect(Tok::number, "(the number of parts)");
-        const int v = std::atoi(n.text.c_str());
+        const int v = std::atoi(std::string(n.text).c_str());
         if (n.text.find_first_not_of("0123456789") != std::string::npos || n.text.size() > 2 || v < 1 ||
             v > 16)
             throw CompileError(n.loc, fmt::format("a topology splits into 1 to 16 parts, not {}", n.text));
@@ -524,7 +524,7 @@ private:
         if (n.text.find_first_not_of("0123456789") != std::string::npos || n.text.size() > 4)
             throw CompileError(n.loc, fmt::format("an entry index is a whole number, not {}", n.text));
         expect(Tok::rbracket, "after the entry index");
-        return std::atoi(n.text.c_str());
+        return std::atoi(std::string(n.text).c_str());
     }
 
     // PRODUCT == PRODUCT, where each factor is an operator cell.name or a constant matrix.
@@ -567,7 +567,7 @@ private:
             take();
             expect(Tok::lparen, "after 'bary'");
             const Token& n = expect(Tok::number, "(the number of weights) in bary(n)");
-            const int v = std::atoi(n.text.c_str());
+            const int v = std::atoi(std::string(n.text).c_str());
             if (v < min_weights || v > 64 || n.text.find_first_not_of("0123456789") != std::string::npos)
                 throw CompileError(n.loc, fmt::format("bary(n) needs an integer n from {} to 64, not {}",
                                                       min_weights, n.text));
@@ -584,7 +584,7 @@ private:
         if (accept(Tok::rparen)) return ps;
         do {
             const Token& name = expect(Tok::ident, "as a parameter name");
-            ps.push_back({name.text, name.loc});
+            ps.push_back({std::string(name.text), name.loc});
         } while (accept(Tok::comma));
         expect(Tok::rparen, "after the parameters");
         return ps;
@@ -636,7 +636,7 @@ private:
             do {
                 const Token& name = expect(Tok::ident, "after 'let'");
                 expect(Tok::assign, "in the let binding");
-                e->bindings.push_back({name.text, name.loc, expr()});
+                e->bindings.push_back({std::string(name.text), name.loc, expr()});
             } while (accept(Tok::comma));
             expect(Tok::kw_in, "after the let bindings");
             e->kids.push_back(expr());
@@ -783,11 +783,11 @@ private:
         }
         case Tok::ident: {
             const Token& name = take();
-            std::string text = name.text;
+            std::string text(name.text);
             // alias.name: a name of a module imported `as alias` (the alias shadows a point's fields).
             if (aliases_.count(text) && at(Tok::dot) && ahead(1).kind == Tok::ident) {
                 take();
-                text += "." + take().text;
+                (text += ".") += take().text;
             }
             if (!at(Tok::lparen)) {
                 auto e = make(ExprKind::name, name.loc);
@@ -901,7 +901,7 @@ private:
             e->series->orbit_map = expect(Tok::ident, "(the map of the orbit)").text;
             if (aliases_.count(e->series->orbit_map) && at(Tok::dot) && ahead(1).kind == Tok::ident) {
                 take();
-                e->series->orbit_map += "." + take().text;
+                (e->series->orbit_map += ".") += take().text;
             }
             expect(Tok::rparen, "to close the orbit");
             // An escape certificate: `escape R`, a radius the compiler proves orbits never return from.
@@ -921,7 +921,7 @@ private:
         return e;
     }
 
-    std::set<std::string> aliases_; // of this file's qualified imports so far
+    std::set<std::string, std::less<>> aliases_; // of this file's qualified imports so far
     const std::vector<Token>& t_;
     Diagnostics& diags_;
     int max_nesting_, max_operators_;

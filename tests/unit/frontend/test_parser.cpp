@@ -128,13 +128,15 @@ TEST_CASE("operators and field accesses of a definition are limited", "[parser][
               "this definition has more than the limit of 100 operators (FRAC_MAX_OPERATORS raises it)");
     }
     Diagnostics d;
-    parse(lex(sum.substr(0, sum.size() - 4) + ";", 1, d), d, limits); // 100 operators
+    const std::string hundred = sum.substr(0, sum.size() - 4) + ";"; // 100 operators
+    parse(lex(hundred, 1, d), d, limits);
     CHECK_FALSE(d.has_errors());
 }
 
 TEST_CASE("the unicode box operator is a token", "[lexer]") {
     Diagnostics d;
-    const auto toks = lex("[0,1] × [0,1]", 1, d);
+    const std::string_view text = "[0,1] × [0,1]";
+    const auto toks = lex(text, 1, d);
     REQUIRE_FALSE(d.has_errors());
     CHECK(toks[5].kind == Tok::times);
     CHECK(toks[6].loc.column == 9); // columns count characters, not bytes
