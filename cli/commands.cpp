@@ -213,6 +213,7 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
     if (!o.output.empty()) check_output_writable(o.output);
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
+    const FreedAtExit keep_model(c);
     if (const front::AutomatonInfo* a = c->module.find_automaton(o.shape)) return render_automaton(*a, o);
     for (const front::Item& it : c->program.items)
         if (it.kind == front::ItemKind::fn && it.name == o.shape && !o.shape.empty())
@@ -239,7 +240,8 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
                                      s.name));
     auto eval = make_evaluator(c->module, s.root, s.dimension, for_covers(engine));
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
-    const rt::RssResult full = cover(box, o.depth, o.split, true, engine.threads, *eval, o.limits);
+    rt::RssResult full = cover(box, o.depth, o.split, true, engine.threads, *eval, o.limits);
+    const FreedAtExit keep_cover(full);
     eval.reset(); // no more evaluation: a background compile not started yet is dropped
     std::cerr << fmt::format(
         "{}: depth {}, {} boxes evaluated: {} inside, {} outside, {} boundary; {:.3f} s\n", s.name, o.depth,
@@ -321,6 +323,7 @@ int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions&
     check_output_writable(o.output);
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
+    const FreedAtExit keep_model(c);
     if (const front::AutomatonInfo* a = c->module.find_automaton(o.shape)) return mesh_automaton(*a, o);
     if (ends_with(o.output, ".svg"))
         throw UsageError("a shape is meshed as .stl, .obj or .ply; .svg is for the curves of automata");
@@ -331,7 +334,8 @@ int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions&
     auto eval = make_evaluator(c->module, s.root, s.dimension, for_covers(engine));
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
     // A mesh is of the closed solid {f <= 0}: cells whose faces lie on its surface are inside.
-    const rt::RssResult r = cover(box, o.depth, o.split, true, engine.threads, *eval, o.limits, true);
+    rt::RssResult r = cover(box, o.depth, o.split, true, engine.threads, *eval, o.limits, true);
+    const FreedAtExit keep_cover(r);
     rt::Mesh mesh;
     try {
         mesh = rt::mesh_cover(r, selection,

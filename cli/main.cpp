@@ -38,9 +38,9 @@ struct Work {
 
 // The work is done and its outputs written. A background compile of the "auto" engine may still be
 // running (the interpreter finished first): leave without waiting for it, and without tearing LLVM
-// down under it.
+// down under it. Objects kept for the exit (cli::FreedAtExit) are freed by leaving the same way.
 int finish(int status) {
-    if (!frac::driver::background_compile_pending()) return status;
+    if (!frac::driver::background_compile_pending() && !frac::cli::objects_kept_for_exit()) return status;
     std::cout.flush();
     std::cerr.flush();
     std::fflush(nullptr);

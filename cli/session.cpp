@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <fmt/format.h>
 #include <iostream>
+#include <mutex>
 #include <sstream>
 #include <string_view>
 
@@ -240,6 +241,32 @@ std::vector<double> parse_point(const std::string& text, int dimension,
 std::string format_interval(ir::Interval v) {
     if (v.is_empty()) return "empty";
     return fmt::format("[{}, {}]", v.lo, v.hi);
+}
+
+namespace {
+
+struct KeptObjects {
+    std::mutex mutex;
+    std::vector<std::shared_ptr<void>> objects;
+};
+
+KeptObjects& kept_objects() {
+    static auto* kept = new KeptObjects; // never destroyed: the process ends with its objects
+    return *kept;
+}
+
+} // namespace
+
+void keep_for_exit(std::shared_ptr<void> object) {
+    KeptObjects& kept = kept_objects();
+    const std::lock_guard lock(kept.mutex);
+    kept.objects.push_back(std::move(object));
+}
+
+bool objects_kept_for_exit() {
+    KeptObjects& kept = kept_objects();
+    const std::lock_guard lock(kept.mutex);
+    return !kept.objects.empty();
 }
 
 } // namespace frac::cli
