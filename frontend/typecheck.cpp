@@ -86,7 +86,7 @@ private:
     }
 
     Type record(const Expr& e, Type t) {
-        out_.exprs[&e] = t;
+        out_.roots[&e] = t;
         return t;
     }
 
@@ -178,8 +178,11 @@ private:
     }
 
     // ---- scopes and calls ----
+    // A definition's expression, checked as a whole: its type is recorded (TypedProgram::roots).
     TValue closed(const Expr& e, Context ctx, bool box_expected = false) {
-        return in_closed_frame(ctx, [&] { return box_expected ? expected_box(e) : expr(e); });
+        TValue v = in_closed_frame(ctx, [&] { return box_expected ? expected_box(e) : expr(e); });
+        record(e, v.type);
+        return v;
     }
 
     // Where a box is expected, `*` between intervals is the ASCII spelling of ×.
@@ -187,24 +190,20 @@ private:
         if (e.kind == ExprKind::binary && e.op == Tok::star) {
             const Type a = expected_box(*e.kids[0]).type;
             const Type b = expr(*e.kids[1]).type;
-            if (is_box_product(a, b)) return TValue::of(record(e, box_product_rule(a, b, e.loc)));
+            if (is_box_product(a, b)) return TValue::of(box_product_rule(a, b, e.loc));
         }
         return expr(e);
     }
 
     TValue inline_body(const Item& it, Scope params, Location call_loc, Context ctx) {
-        return in_call_frame(Frame{ctx, {std::move(params)}, 0}, &it, call_loc, call_note(it, call_loc),
-                             [&] { return expr(*it.body); });
+        TValue v = in_call_frame(Frame{ctx, {std::move(params)}, 0}, &it, call_loc, call_note(it, call_loc),
+                                 [&] { return expr(*it.body); });
+        record(*it.body, v.type);
+        return v;
     }
 
     // ---- expressions ----
     TValue expr(const Expr& e) {
-        TValue v = expr_kind(e);
-        record(e, v.type);
-        return v;
-    }
-
-    TValue expr_kind(const Expr& e) {
         switch (e.kind) {
         case ExprKind::number: return TValue::of(Type::number());
         case ExprKind::name: return name(e);
@@ -757,7 +756,7 @@ void typecheck(const Program& program, const Limits& limits, TypedProgram& out, 
 std::string print_types(const Program& program, const TypedProgram& typed, std::uint32_t file) {
     std::string out;
     const auto type_of = [&](const Expr* e) {
-        const Type* t = typed.exprs.find(e);
+        const Type* t = typed.roots.find(e);
         return t ? type_spelling(*t) : std::string("unchecked");
     };
     for (const Item& it : program.items) {

@@ -31,13 +31,15 @@ TEST_CASE("a generic function is checked once per signature", "[typecheck]") {
         signatures.push_back(type_spelling(f.params[0]));
     }
     CHECK(signatures == std::vector<std::string>{"number", "point2"});
-    // Every expression of the shape has a type in the typed tree.
-    for (const Item& it : c->program.items)
+    // The shape's expression and the function's body have their types in the typed program.
+    for (const Item& it : c->program.items) {
+        if (it.kind == ItemKind::fn) CHECK(c->typed.roots.at(it.body.get()) == Type::point(2)); // the latest
         if (it.kind == ItemKind::shape) {
-            REQUIRE(c->typed.exprs.count(it.body.get()));
-            CHECK(c->typed.exprs.at(it.body.get()) == Type::number());
+            REQUIRE(c->typed.roots.count(it.body.get()));
+            CHECK(c->typed.roots.at(it.body.get()) == Type::number());
             CHECK(c->typed.items.at(&it) == Type{Type::Kind::shape, 2});
         }
+    }
 }
 
 TEST_CASE("matrices and transforms have sized types", "[typecheck]") {
