@@ -6,8 +6,8 @@
 
 #include "frontend/ast.hpp"
 #include "frontend/lower.hpp"
-#include "frontend/pointer_map.hpp"
 #include "frontend/types.hpp"
+#include "support/flat_map.hpp"
 
 #include <string>
 #include <unordered_map>
@@ -31,7 +31,7 @@ struct TypedProgram {
     // The type of each expression checked as a whole: the body of a const, shape, print or function
     // (under its latest instance), a shape's box, an expectation's sides, an automaton's operators,
     // probabilities and projections.
-    PointerMap<Expr, Type> roots;
+    support::FlatMap<const Expr*, Type> roots;
     // The items and expectations (Expect) with a type error, reported: lowering skips them and lowers
     // the rest, so that errors that need values are found in the same run.
     std::unordered_set<const void*> failed;

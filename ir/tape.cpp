@@ -1,10 +1,10 @@
 #include "ir/tape.hpp"
 #include "ir/series_tail.hpp"
+#include "support/flat_map.hpp"
 
 #include <bit>
 #include <fmt/format.h>
 #include <stdexcept>
-#include <unordered_map>
 
 namespace frac::ir {
 
@@ -13,6 +13,9 @@ namespace {
 int highest_level(std::uint64_t mask) {
     return mask == 0 ? 0 : 63 - std::countl_zero(mask);
 }
+
+// The slot of each node emitted in a context (a large model's tape has a hundred thousand).
+using SlotMemo = support::FlatMap<NodeId, Slot, no_node>;
 
 class Scheduler {
 public:
@@ -28,7 +31,7 @@ private:
     struct Context {
         int level;
         std::uint32_t block;
-        std::unordered_map<NodeId, Slot> memo;
+        SlotMemo memo;
     };
 
     Slot fresh() { return t_.num_slots++; }
@@ -42,12 +45,10 @@ private:
     Slot emit(NodeId id) {
         const Node& n = g_[id];
         if (n.op == Op::Const) {
-            auto [it, added] = const_slots_.try_emplace(id, no_slot);
-            if (added) {
-                it->second = fresh();
-                t_.constants.push_back({it->second, n.value, n.point});
-            }
-            return it->second;
+            if (const Slot* known = const_slots_.find(id)) return *known;
+            const Slot s = const_slots_[id] = fresh();
+            t_.constants.push_back({s, n.value, n.point});
+            return s;
         }
         if (n.op == Op::Var) {
             if (n.imm < 0 || n.imm >= t_.inputs)
@@ -57,7 +58,7 @@ private:
             return s;
         }
         Context& ctx = context_for(highest_level(n.index_mask));
-        if (auto it = ctx.memo.find(id); it != ctx.memo.end()) return it->second;
+        if (const Slot* known = ctx.memo.find(id)) return *known;
         if (capture_) return emit_captured(id);
         if (n.op == Op::Index) {
             // The index slot is allocated by the series that owns this context.
@@ -92,12 +93,12 @@ private:
         t_.blocks.emplace_back();
         s.index_slot = fresh();
         contexts_.push_back({n.series.level, s.block, {}});
-        contexts_.back().memo[find_leaf(Op::Index, n.series.level)] = s.index_slot;
+        bind_leaf(find_leaf(Op::Index, n.series.level), s.index_slot);
         const auto states = static_cast<std::size_t>(n.series.state_count);
         for (std::size_t c = 0; c < states; ++c) {
             s.state_slots.push_back(fresh());
-            contexts_.back().memo[find_leaf(Op::State, state_imm(n.series.level, static_cast<int>(c)))] =
-                s.state_slots.back();
+            bind_leaf(find_leaf(Op::State, state_imm(n.series.level, static_cast<int>(c))),
+                      s.state_slots.back());
         }
         s.body_slot = emit(n.args[0]);
         for (std::size_t c = 0; c < states; ++c) s.update_slots.push_back(emit(n.orbit[states + c]));
@@ -118,7 +119,7 @@ private:
     // Point-only code of a series (TapeSeries::point_block): nodes not computed by the enclosing
     // blocks go to the capture block, so box evaluation never runs them.
     Slot emit_captured(NodeId id) {
-        if (auto it = capture_->memo.find(id); it != capture_->memo.end()) return it->second;
+        if (const Slot* known = capture_->memo.find(id)) return *known;
         if (is_series(g_[id].op) || g_[id].op == Op::Index || g_[id].op == Op::State)
             throw std::logic_error("tape: a point bound reads a value its series has not computed");
         const Slot out = emit_op(id, *capture_);
@@ -146,6 +147,12 @@ private:
         }
     }
 
+    // The series' own index or state (a leaf of the graph, absent when its body does not read it) has
+    // the slot the series sets.
+    void bind_leaf(NodeId leaf, Slot slot) {
+        if (leaf != no_node) contexts_.back().memo[leaf] = slot;
+    }
+
     NodeId find_leaf(Op op, std::int64_t imm) {
         // Index and state nodes are few; a linear scan once per series keeps Graph free of a reverse map.
         for (NodeId i = 0; i < g_.size(); ++i)
@@ -157,7 +164,7 @@ private:
     Tape& t_;
     std::vector<Context> contexts_;
     Context* capture_ = nullptr;
-    std::unordered_map<NodeId, Slot> const_slots_;
+    SlotMemo const_slots_;
 };
 
 } // namespace
