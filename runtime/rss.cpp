@@ -289,6 +289,7 @@ private:
         const int remaining = r_.depth - k;
         consider_pruning_ = remaining >= std::max(1, r_.options.prune_min_remaining);
         expected_descendants_ = expected_descendants(remaining);
+        min_cells_per_chunk_ = min_cells_per_chunk(k);
         if (k == 0)
             level_cells_ = 1;
         else
@@ -366,6 +367,18 @@ private:
         if (level_ == 0 || end >= level_cells_) return end;
         const std::uint64_t start = block_of(end)->first;
         return start > begin ? start : end;
+    }
+
+    // Where a chunk of cells from `begin` ends, near `end`, when siblings are kept together: at the
+    // start of the block that `end` falls in, if after `begin`; else, the chunk lying inside one block,
+    // at the block's end (at most `limit`, the batch's end), since a parent's children lie in every
+    // child row of its block: a block cut anywhere splits some parent's children.
+    std::uint64_t chunk_end(std::uint64_t begin, std::uint64_t end, std::uint64_t limit) const {
+        if (level_ == 0 || end >= level_cells_) return end;
+        const auto block = block_of(end);
+        if (block->first > begin) return block->first;
+        const auto s = static_cast<std::uint64_t>(r_.split);
+        return std::min(limit, block->first + block->count * s * s);
     }
 
     // The block (plan_children) that holds cell c of the level (level >= 1).
@@ -495,6 +508,23 @@ private:
             box[a] = cell_interval(static_cast<std::size_t>(a), pos[static_cast<std::size_t>(a)]);
     }
 
+    // The fewest cells a chunk of level k takes: min_chunk where a cell's function is short (a
+    // chunk then runs long enough to repay handing it to a thread), fewer where it is long, by the
+    // instructions per evaluation of the level before (the parents' functions: an upper bound on
+    // their children's, which are pruned from them). The first levels of a large model have a few
+    // cells that each evaluate tens of thousands of instructions and push tapes: as single chunks they
+    // ran on one thread, about a seventh of the work of a depth-10 cover of 7000 clauses.
+    std::size_t min_cells_per_chunk(int k) const {
+        double per_cell = variants_[0].instructions;
+        if (k > 0) {
+            const auto before = static_cast<std::size_t>(k - 1);
+            const double evaluated = static_cast<double>(r_.levels[before].evaluated);
+            if (evaluated > 0) per_cell = r_.prune_levels[before].instructions / evaluated;
+        }
+        const double cells = std::ceil(min_chunk_instructions / std::max(1.0, per_cell));
+        return static_cast<std::size_t>(std::clamp(cells, 1.0, static_cast<double>(min_chunk)));
+    }
+
     // Sizes a batch for cells [first, first + m) and cuts it into up to chunks_per_thread chunks per
     // thread.
     void prepare(Batch& b, std::uint64_t first, std::size_t m) {
@@ -507,12 +537,12 @@ private:
         const auto k = std::max<std::size_t>(
             1,
             std::min<std::size_t>(threads_ == 1 ? 1 : chunks_per_thread * static_cast<std::size_t>(threads_),
-                                  (m + min_chunk - 1) / min_chunk));
+                                  (m + min_cells_per_chunk_ - 1) / min_cells_per_chunk_));
         b.chunks.clear();
-        for (std::size_t c = 0, begin = 0; c < k; ++c) {
-            std::size_t end = m * (c + 1) / k;
-            if (keep_siblings_ && c + 1 < k)
-                end = static_cast<std::size_t>(sibling_cut(first + begin, first + end) - first);
+        for (std::size_t c = 0, begin = 0; c < k && begin < m; ++c) {
+            std::size_t end = c + 1 == k ? m : std::max(begin, m * (c + 1) / k);
+            if (keep_siblings_ && end < m)
+                end = static_cast<std::size_t>(chunk_end(first + begin, first + end, first + m) - first);
             if (end == begin) continue;
             b.chunks.push_back({begin, end});
             begin = end;
@@ -702,7 +732,8 @@ private:
         for (Pos& p : frontier) p.variant = renumber[p.variant];
     }
 
-    static constexpr std::size_t min_chunk = 256;              // below this a thread costs more than it saves
+    static constexpr std::size_t min_chunk = 256; // cells: below this a thread costs more than it saves...
+    static constexpr double min_chunk_instructions = 256 * 64; // ... when they evaluate 64 instructions each
     static constexpr std::uint64_t grid_table_limit = 1 << 16; // cells per axis with a table of grid points
     static constexpr std::size_t chunks_per_thread = 8;        // dynamic balance between threads
     ir::Evaluator& f_;
@@ -728,6 +759,7 @@ private:
     int filling_ = 0;
     std::vector<ChildBlock> blocks_; // the order of the level's cells (plan_children)
     std::uint64_t level_cells_ = 0;  // ... and their number
+    std::size_t min_cells_per_chunk_ = min_chunk;
     std::vector<LevelVariant> level_variants_;
     bool prune_in_chunks_ = false;    // some of the level's cells prune in the chunks
     bool consider_pruning_ = false;   // the level's undecided cells ask for pruned functions

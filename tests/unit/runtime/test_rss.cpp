@@ -313,15 +313,18 @@ namespace {
 
 // A disk whose every tape push (in the chunks, as the interpreter's) returns an evaluator of its own,
 // which logs the size of each of its eval_boxes calls: the children of a parent evaluated side by side
-// log one call of 4.
+// log one call of 4. It says it has `instructions` instructions (a long function makes the chunks of
+// few cells).
 class PushingDisk : public Disk {
 public:
     struct Log {
         std::mutex mu;
         std::map<int, std::vector<std::size_t>> calls; // by evaluator (0: the shape's)
         int pushed = 0;
+        std::size_t instructions = 0;
     };
     PushingDisk(std::shared_ptr<Log> log, int id) : Disk(0.1, -0.2, 0.6), log(std::move(log)), id(id) {}
+    std::size_t instruction_count() const override { return log->instructions; }
     bool may_specialize() const override { return true; }
     bool specializes_independently() const override { return true; }
     std::size_t kept_evaluations() const override { return 4; }
@@ -348,24 +351,27 @@ TEST_CASE("rss: a parent's children stay in one chunk when they push tapes", "[r
     // Batches and chunks cut the level's order (row-major: a parent's children lie in two rows); cut
     // between those rows, its children would evaluate and push in two halves. (Batches at least as
     // large as a parent row's children: a smaller one cannot help cutting them.)
-    for (const std::size_t batch : {std::size_t{300}, std::size_t{1000}, std::size_t{4096}}) {
-        for (const int threads : {1, 2}) {
-            auto log = std::make_shared<PushingDisk::Log>();
-            PushingDisk disk(log, 0);
-            RssOptions o = opts(7);
-            o.batch = batch;
-            o.threads = threads;
-            const RssResult r = subdivide(disk, square, o);
-            check_consistency(r);
-            INFO("batch " << batch << ", " << threads << " threads");
-            REQUIRE(log->pushed > 300);
-            for (const auto& [id, calls] : log->calls) {
-                if (id == 0) continue;
-                INFO("pushed evaluator " << id);
-                REQUIRE(calls == std::vector<std::size_t>{4});
+    // A function of 100,000 instructions makes chunks of single cells where they do not split blocks.
+    for (const std::size_t instructions : {std::size_t{0}, std::size_t{100000}})
+        for (const std::size_t batch : {std::size_t{300}, std::size_t{1000}, std::size_t{4096}}) {
+            for (const int threads : {1, 2}) {
+                auto log = std::make_shared<PushingDisk::Log>();
+                log->instructions = instructions;
+                PushingDisk disk(log, 0);
+                RssOptions o = opts(7);
+                o.batch = batch;
+                o.threads = threads;
+                const RssResult r = subdivide(disk, square, o);
+                check_consistency(r);
+                INFO("batch " << batch << ", " << threads << " threads, " << instructions << " instructions");
+                REQUIRE(log->pushed > 300);
+                for (const auto& [id, calls] : log->calls) {
+                    if (id == 0) continue;
+                    INFO("pushed evaluator " << id);
+                    REQUIRE(calls == std::vector<std::size_t>{4});
+                }
             }
         }
-    }
 }
 
 TEST_CASE("rss: progress reports each level", "[rss]") {
