@@ -8,9 +8,11 @@
 // Prints tables of ratios and writes JSON.
 //
 //   bench_prune [depth=10] [json=bench_prune.json] [depth_3d=7]
+#include "backend/interp/flat_interpreter.hpp"
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/jit.hpp"
 #include "bench/bench_common.hpp"
+#include "bench/large_models.hpp"
 #include "driver/pipeline.hpp"
 #include "ir/specialize.hpp"
 #include "ir/tape.hpp"
@@ -33,9 +35,12 @@ using bench::seconds_since;
 using bench::Shape;
 
 // The named shape of a model file (relative to the source tree) or of a stdlib module.
-Shape load(const std::string& source, const std::string& name, bool is_file) {
-    auto c = is_file ? driver::compile_file(std::string(FRAC_SOURCE_DIR) + "/" + source)
-                     : driver::compile_source("bench.frac", "import \"" + source + "\";");
+// A shape of a file of the tree (is_file), of a library module, or of the model text `source`.
+enum class From { file, module, text };
+Shape load(const std::string& source, const std::string& name, From from) {
+    auto c = from == From::file     ? driver::compile_file(std::string(FRAC_SOURCE_DIR) + "/" + source)
+             : from == From::module ? driver::compile_source("bench.frac", "import \"" + source + "\";")
+                                    : driver::compile_source("bench.frac", source);
     if (!c->ok()) {
         std::cerr << c->diags.render(c->sources);
         std::exit(1);
@@ -131,6 +136,31 @@ std::pair<double, double> fit(const std::vector<double>& x, const std::vector<do
     return {(sy - b * sx) / n, b};
 }
 
+// Distinct pruned tapes of a shape (at most `count`), from the choices recorded over sub-boxes of its
+// cover's cells at `depth`, and those cells' boxes.
+struct PrunedSet {
+    std::vector<ir::Tape> tapes;
+    std::vector<ir::Interval> boxes;
+};
+PrunedSet pruned_tapes(const Shape& shape, int depth, std::size_t count) {
+    PrunedSet set;
+    auto e = interp::make_interpreter(shape.tape);
+    rt::RssOptions ro;
+    ro.depth = depth;
+    const rt::RssResult r = rt::subdivide(*e, shape.box, ro);
+    set.boxes = cell_boxes(r);
+    const auto d = static_cast<std::size_t>(shape.dimension);
+    interp::ChoiceRecorder rec(shape.tape, {});
+    std::set<std::string> seen;
+    for (std::size_t i = 0; d * (i + 1) <= set.boxes.size() && set.tapes.size() < count; i += 37) {
+        const auto choices = rec.record(&set.boxes[d * i]);
+        if (!ir::any_decided(choices)) continue;
+        ir::Tape t = ir::specialize(shape.tape, choices);
+        if (seen.insert(ir::tape_key(t)).second) set.tapes.push_back(std::move(t));
+    }
+    return set;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -143,34 +173,24 @@ int main(int argc, char** argv) {
         return 1;
     }
     std::vector<Shape> shapes = {
-        load("bench/csg_scene.frac", "csg_scene", true), load("koch", "double_koch", false),
-        load("examples/menger_frame.frac", "sponge_in_frame", true),
-        load("fractals", "carpet", false), // no min/max outside its series: nothing to prune
+        load("bench/csg_scene.frac", "csg_scene", From::file), load("koch", "double_koch", From::module),
+        load("examples/menger_frame.frac", "sponge_in_frame", From::file),
+        load("fractals", "carpet", From::module), // no min/max outside its series: nothing to prune
     };
     const Shape& scene = shapes[0];
     std::string json = "{\n";
 
     // ---- 1. The rule's constants ----
-    // Pruned tapes of the scene: choices recorded over random sub-boxes of its cover's cells.
-    std::vector<ir::Tape> pruned;
-    std::vector<ir::Interval> scene_boxes;
-    {
-        auto e = interp::make_interpreter(scene.tape);
-        rt::RssOptions ro;
-        ro.depth = 6;
-        const rt::RssResult r = rt::subdivide(*e, scene.box, ro);
-        scene_boxes = cell_boxes(r);
-        interp::ChoiceRecorder rec(scene.tape, {});
-        std::set<std::string> seen;
-        for (std::size_t i = 0; i + 1 < scene_boxes.size() && pruned.size() < 24; i += 2 * 37) {
-            const auto choices = rec.record(&scene_boxes[i]);
-            if (!ir::any_decided(choices)) continue;
-            ir::Tape t = ir::specialize(scene.tape, choices);
-            if (seen.insert(ir::tape_key(t)).second) pruned.push_back(std::move(t));
-        }
-    }
+    // Pruned tapes of the scene (its carpet's series run on the tape interpreter) and of a generated
+    // 300-clause model (flat: the flat interpreter runs them), from choices recorded over sub-boxes
+    // of their covers' cells.
+    const PrunedSet scene_set = pruned_tapes(scene, 6, 24);
+    const Shape flat_model = load(bench::large_model(300).source, bench::large_model(300).name, From::text);
+    const PrunedSet flat_set = pruned_tapes(flat_model, 6, 24);
+    const std::vector<ir::Tape>& pruned = scene_set.tapes;
+    const std::vector<ir::Interval>& scene_boxes = scene_set.boxes;
     // Compile time of the JIT against the pruned tape's size (best of 3 per tape).
-    std::vector<double> sizes, compile_ms, costs, jit_ns, interp_ns;
+    std::vector<double> sizes, compile_ms, costs, jit_ns, interp_ns, tape_interp_ns;
     for (const ir::Tape& t : pruned) {
         double best = 1e300;
         for (int r = 0; r < 3; ++r) best = std::min(best, jit::compile_info(*jit::make_jit(t))->total_ms);
@@ -189,19 +209,34 @@ int main(int argc, char** argv) {
         }
         interp_make_us += best / double(pruned.size());
     }
-    // Evaluation time per unit of tape cost: the full and the pruned tapes over the same boxes.
+    // Evaluation time per unit of tape cost: the full and the pruned tapes over the same boxes, by the
+    // JIT and the tape interpreter (the scene's), and by the flat interpreter (the flat model's).
     std::vector<ir::Tape> timed = pruned;
     timed.push_back(scene.tape);
     for (const ir::Tape& t : timed) {
         costs.push_back(ir::tape_cost(t));
         jit_ns.push_back(ns_per_box(*jit::make_jit(t), scene_boxes, 3));
         interp_ns.push_back(ns_per_box(*interp::make_interpreter(t), scene_boxes, 1));
+        tape_interp_ns.push_back(ns_per_box(*interp::make_tape_interpreter(t), scene_boxes, 1));
+    }
+    std::vector<ir::Tape> flat_timed = flat_set.tapes;
+    flat_timed.push_back(flat_model.tape);
+    std::vector<double> flat_costs, flat_ns, flat_tape_ns;
+    for (const ir::Tape& t : flat_timed) {
+        if (!interp::runs_flat(t)) continue;
+        flat_costs.push_back(ir::tape_cost(t));
+        flat_ns.push_back(ns_per_box(*interp::make_interpreter(t), flat_set.boxes, 3));
+        flat_tape_ns.push_back(ns_per_box(*interp::make_tape_interpreter(t), flat_set.boxes, 1));
     }
     const auto [jit_ns0, jit_ns_per_cost] = fit(costs, jit_ns);
-    const auto [interp_ns0, interp_ns_per_cost] = fit(costs, interp_ns);
+    const auto [tape_interp_ns0, tape_interp_ns_per_cost] = fit(costs, tape_interp_ns);
+    const auto [flat_ns0, flat_ns_per_cost] = fit(flat_costs, flat_ns);
+    const auto [flat_tape_ns0, flat_tape_ns_per_cost] = fit(flat_costs, flat_tape_ns);
     fmt::print(
-        "Pruning rule constants ({} pruned tapes of csg_scene, {} instructions unpruned, cost {:.0f})\n",
-        pruned.size(), scene.tape.instruction_count(), ir::tape_cost(scene.tape));
+        "Pruning rule constants ({} pruned tapes of csg_scene, {} instructions unpruned, cost {:.0f};\n"
+        "{} flat tapes of {}: pruned, and unpruned with {} instructions, cost {:.0f})\n",
+        pruned.size(), scene.tape.instruction_count(), ir::tape_cost(scene.tape), flat_costs.size(),
+        flat_model.name, flat_model.tape.instruction_count(), ir::tape_cost(flat_model.tape));
     fmt::print(
         "  JIT compile:      {:.2f} ms + {:.4f} ms per instruction   (in use: {:.2f} ms + {:.4f} ms)\n",
         compile_fixed, compile_per_instr, jit::jit_prune_costs.compile_ns_fixed * 1e-6,
@@ -210,21 +245,29 @@ int main(int argc, char** argv) {
                interp::interp_prune_costs.compile_ns_fixed * 1e-3);
     fmt::print("  JIT eval:         {:.1f} ns + {:.3f} ns per cost unit, per box   (in use: {:.3f})\n",
                jit_ns0, jit_ns_per_cost, jit::jit_prune_costs.eval_ns_per_cost);
-    fmt::print("  interpreter eval: {:.1f} ns + {:.3f} ns per cost unit, per box   (in use: {:.3f})\n",
-               interp_ns0, interp_ns_per_cost, interp::interp_prune_costs.eval_ns_per_cost);
-    fmt::print("  {:>8} {:>8} {:>11} {:>10} {:>12}\n", "instrs", "cost", "compile ms", "jit ns/box",
-               "interp ns/box");
+    fmt::print("  tape interpreter: {:.1f} ns + {:.3f} ns per cost unit, per box   (in use: {:.3f})\n",
+               tape_interp_ns0, tape_interp_ns_per_cost, interp::tape_eval_ns_per_cost);
+    fmt::print("  flat interpreter: {:.1f} ns + {:.3f} ns per cost unit, per box   (in use: {:.3f}; the tape "
+               "interpreter on the same tapes: {:.1f} ns + {:.3f})\n",
+               flat_ns0, flat_ns_per_cost, interp::flat_eval_ns_per_cost, flat_tape_ns0,
+               flat_tape_ns_per_cost);
+    fmt::print("  {:>8} {:>8} {:>11} {:>10} {:>12} {:>12}\n", "instrs", "cost", "compile ms", "jit ns/box",
+               "interp ns/box", "tape ns/box");
     for (std::size_t i = 0; i < timed.size(); ++i)
-        fmt::print("  {:>8} {:>8.0f} {:>11} {:>10.1f} {:>12.1f}{}\n", timed[i].instruction_count(), costs[i],
-                   i < compile_ms.size() ? fmt::format("{:.2f}", compile_ms[i]) : "-", jit_ns[i],
-                   interp_ns[i], i + 1 == timed.size() ? "  (unpruned)" : "");
-    json += fmt::format("  \"rule\": {{\"pruned_tapes\": {}, \"jit_compile_ms_fixed\": {:.4f}, "
-                        "\"jit_compile_ms_per_instruction\": {:.6f}, \"interp_make_us\": {:.3f}, "
-                        "\"jit_eval_ns_fixed\": {:.3f}, "
-                        "\"jit_eval_ns_per_cost\": {:.5f}, \"interp_eval_ns_fixed\": {:.3f}, "
-                        "\"interp_eval_ns_per_cost\": {:.5f}}},\n",
-                        pruned.size(), compile_fixed, compile_per_instr, interp_make_us, jit_ns0,
-                        jit_ns_per_cost, interp_ns0, interp_ns_per_cost);
+        fmt::print("  {:>8} {:>8.0f} {:>11} {:>10.1f} {:>12.1f} {:>12.1f}{}\n", timed[i].instruction_count(),
+                   costs[i], i < compile_ms.size() ? fmt::format("{:.2f}", compile_ms[i]) : "-", jit_ns[i],
+                   interp_ns[i], tape_interp_ns[i], i + 1 == timed.size() ? "  (unpruned)" : "");
+    fmt::print("  {:>8} {:>12} {:>12}   ({})\n", "cost", "flat ns/box", "tape ns/box", flat_model.name);
+    for (std::size_t i = 0; i < flat_costs.size(); ++i)
+        fmt::print("  {:>8.0f} {:>12.1f} {:>12.1f}\n", flat_costs[i], flat_ns[i], flat_tape_ns[i]);
+    json +=
+        fmt::format("  \"rule\": {{\"pruned_tapes\": {}, \"jit_compile_ms_fixed\": {:.4f}, "
+                    "\"jit_compile_ms_per_instruction\": {:.6f}, \"interp_make_us\": {:.3f}, "
+                    "\"jit_eval_ns_fixed\": {:.3f}, \"jit_eval_ns_per_cost\": {:.5f}, "
+                    "\"tape_interp_eval_ns_fixed\": {:.3f}, \"tape_interp_eval_ns_per_cost\": {:.5f}, "
+                    "\"flat_interp_eval_ns_fixed\": {:.3f}, \"flat_interp_eval_ns_per_cost\": {:.5f}}},\n",
+                    pruned.size(), compile_fixed, compile_per_instr, interp_make_us, jit_ns0, jit_ns_per_cost,
+                    tape_interp_ns0, tape_interp_ns_per_cost, flat_ns0, flat_ns_per_cost);
 
     // ---- 2. Covers with pruning off and on ----
     fmt::print(

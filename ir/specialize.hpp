@@ -145,10 +145,12 @@ inline constexpr std::size_t max_specializations = 512;
 class SpecializationCache {
 public:
     using Compile = std::function<std::unique_ptr<Evaluator>(const Tape&)>;
+    using CostOf = std::function<double(const Tape&)>;
     // `fallback` (optional) makes the second tier's evaluator of a tape, whose results are the
-    // engine's bit for bit; `fallback_ns_per_cost` is its evaluation time per unit of tape cost.
+    // engine's bit for bit; `fallback_ns_per_cost` gives its evaluation time per unit of a tape's cost
+    // (the interpreter's depends on the tape: flat or not).
     SpecializationCache(Compile compile, PruneCosts costs, Compile fallback = {},
-                        double fallback_ns_per_cost = 0)
+                        CostOf fallback_ns_per_cost = {})
         : compile_(std::move(compile)), fallback_(std::move(fallback)), costs_(costs),
           fallback_ns_per_cost_(fallback_ns_per_cost) {}
 
@@ -167,7 +169,7 @@ private:
     };
     Compile compile_, fallback_;
     PruneCosts costs_;
-    double fallback_ns_per_cost_;
+    CostOf fallback_ns_per_cost_;
     mutable std::mutex mu_; // held while compiling, so no tape is compiled twice
     std::map<std::string, Entry> entries_;
     std::size_t compiled_count_ = 0;

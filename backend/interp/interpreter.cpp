@@ -339,6 +339,10 @@ std::unique_ptr<ir::Evaluator> make_interpreter(ir::Tape tape, const ir::EvalOpt
     return make_tape_interpreter(std::move(tape), options);
 }
 
+double eval_ns_per_cost(const ir::Tape& tape) {
+    return runs_flat(tape) ? flat_eval_ns_per_cost : tape_eval_ns_per_cost;
+}
+
 std::unique_ptr<ir::Evaluator> make_tape_interpreter(ir::Tape tape, const ir::EvalOptions& options) {
     return std::make_unique<Interpreter>(std::move(tape), options);
 }

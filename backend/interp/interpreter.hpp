@@ -16,8 +16,21 @@ std::unique_ptr<ir::Evaluator> make_interpreter(ir::Tape tape, const ir::EvalOpt
 // the reference the flat interpreter is tested against.
 std::unique_ptr<ir::Evaluator> make_tape_interpreter(ir::Tape tape, const ir::EvalOptions& options = {});
 
-// What specialising costs the interpreter (a tape copy, no compilation), measured by bench/bench_prune.
-inline constexpr ir::PruneCosts interp_prune_costs{/*eval_ns_per_cost=*/33.0, /*compile_ns_fixed=*/2000.0,
+// Evaluation time per unit of tape cost (ir::tape_cost) and box, measured by bench/bench_prune: the
+// tape interpreter (tapes with series or external functions) on the pruned tapes of its CSG scene,
+// the flat interpreter (four boxes side by side on vector kernels) on those of a 300-clause model.
+// They weigh against the JIT's jit_prune_costs.eval_ns_per_cost (0.8), so they keep the ratios
+// measured in one run: the flat interpreter 1.42 ns per cost, the JIT 0.35 and the tape interpreter
+// 12.7 (a quiet run: 4.0 and 36 times the JIT; the tape interpreter's 33 is 41 times the JIT's 0.8;
+// docs/performance.md "The JIT's second tier"): 3.2 is 4.0 times the JIT's constant.
+inline constexpr double flat_eval_ns_per_cost = 3.2;
+inline constexpr double tape_eval_ns_per_cost = 33.0;
+// That of the interpreter make_interpreter picks for `tape`.
+double eval_ns_per_cost(const ir::Tape& tape);
+
+// What specialising costs the interpreter (a tape copy, no compilation), measured by bench/bench_prune;
+// its evaluation time is the tape interpreter's (eval_ns_per_cost tells a flat tape's).
+inline constexpr ir::PruneCosts interp_prune_costs{tape_eval_ns_per_cost, /*compile_ns_fixed=*/2000.0,
                                                    /*compile_ns_per_instruction=*/0.0};
 
 // Recording the choices over a box and building the pruned tape cost about as much as the 4

@@ -428,7 +428,7 @@ std::unique_ptr<ir::Evaluator> make_jit(const ir::Tape& tape, const ir::EvalOpti
         // Until a pruned tape has earned its compile time, the interpreter runs it when that is faster
         // than the JIT running the whole tape; its enclosures are the JIT's bit for bit.
         [options](const ir::Tape& t) { return interp::make_interpreter(t, options); },
-        interp::interp_prune_costs.eval_ns_per_cost);
+        [](const ir::Tape& t) { return interp::eval_ns_per_cost(t); });
     *self = cache;
     root->own_cache(std::move(cache));
     return root;

@@ -3,6 +3,7 @@
 // are the same for both engines, are compiled once (cache), and leave every RSS cover unchanged.
 #include "engines.hpp"
 
+#include "backend/interp/flat_interpreter.hpp"
 #include "backend/interp/interpreter.hpp"
 #include "bench/large_models.hpp"
 #include "driver/engines.hpp"
@@ -178,7 +179,7 @@ TEST_CASE("the JIT declines to compile a pruned tape that would not repay it", "
     const std::vector<Interval> disk_box{{0.98, 1.02}, {0.48, 0.52}};
     interp::ChoiceRecorder rec(tape, {});
     const ir::Tape disk_only = ir::specialize(tape, rec.record(disk_box.data()));
-    const bool interp_faster = interp::interp_prune_costs.eval_ns_per_cost * ir::tape_cost(disk_only) <
+    const bool interp_faster = interp::eval_ns_per_cost(disk_only) * ir::tape_cost(disk_only) <
                                jit::jit_prune_costs.eval_ns_per_cost * ir::tape_cost(tape);
     auto tier2 = jt->specialize(disk_box.data(), jit::jit_min_expected_evaluations);
     CHECK(bool(tier2) == interp_faster);
@@ -188,6 +189,21 @@ TEST_CASE("the JIT declines to compile a pruned tape that would not repay it", "
         CHECK(jt->specialize_stats.fallbacks == 1);
         CHECK(same(tier2->eval_box(disk_box.data()), jt->eval_box(disk_box.data())));
     }
+}
+
+TEST_CASE("the second tier's evaluation cost is that of the interpreter running the pruned tape",
+          "[llvm][prune]") {
+    const Model m = compile(csg_model);
+    const ir::Tape& scene = tape_of(m, "scene");
+    REQUIRE_FALSE(interp::runs_flat(scene)); // the carpet's series
+    CHECK(interp::eval_ns_per_cost(scene) == interp::tape_eval_ns_per_cost);
+    const std::vector<Interval> disk_box{{0.98, 1.02}, {0.48, 0.52}};
+    interp::ChoiceRecorder rec(scene, {});
+    const ir::Tape disk_only = ir::specialize(scene, rec.record(disk_box.data()));
+    REQUIRE(interp::runs_flat(disk_only));
+    CHECK(interp::eval_ns_per_cost(disk_only) == interp::flat_eval_ns_per_cost);
+    // bench/bench_prune measures both: the flat interpreter is the faster.
+    CHECK(interp::flat_eval_ns_per_cost < interp::tape_eval_ns_per_cost);
 }
 
 TEST_CASE("the interpreter prunes from the values its last evaluation left", "[llvm][prune]") {
