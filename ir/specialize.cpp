@@ -457,7 +457,8 @@ std::shared_ptr<Evaluator> SpecializationCache::get(const Tape& current, const s
         entry.fallback.reset();
         return entry.compiled;
     }
-    if (fallback_ && fallback_ns_per_cost_(pruned) * after < costs_.eval_ns_per_cost * before) {
+    if (fallback_ && fallback_ns_per_cost_ &&
+        fallback_ns_per_cost_(pruned) * after < costs_.eval_ns_per_cost * before) {
         if (entry.fallback) {
             ++stats.hits;
         } else {

@@ -148,7 +148,7 @@ public:
     using CostOf = std::function<double(const Tape&)>;
     // `fallback` (optional) makes the second tier's evaluator of a tape, whose results are the
     // engine's bit for bit; `fallback_ns_per_cost` gives its evaluation time per unit of a tape's cost
-    // (the interpreter's depends on the tape: flat or not).
+    // (the interpreter's depends on the tape: flat or not); without it the fallback is never used.
     SpecializationCache(Compile compile, PruneCosts costs, Compile fallback = {},
                         CostOf fallback_ns_per_cost = {})
         : compile_(std::move(compile)), fallback_(std::move(fallback)), costs_(costs),
