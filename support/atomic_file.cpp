@@ -1,4 +1,5 @@
 #include "support/atomic_file.hpp"
+#include "support/process_cleaner.hpp"
 
 #include <atomic>
 #include <cerrno>
@@ -51,6 +52,7 @@ AtomicFile::AtomicFile(std::string path, std::string what) : path_(resolved(path
         // No unnamed files here: a named temporary, removed on failure or by the next run.
         for (int attempt = 0; attempt < 100 && fd_ < 0; ++attempt) {
             named_temp_ = next_temp_name(target);
+            remove_when_process_ends(named_temp_);
             fd_ = ::open(named_temp_.c_str(), O_CREAT | O_EXCL | O_WRONLY | O_CLOEXEC, 0666);
             if (fd_ < 0 && errno != EEXIST) break;
         }
@@ -117,6 +119,8 @@ void AtomicFile::commit() {
         const std::string proc = "/proc/self/fd/" + std::to_string(fd_);
         for (int attempt = 0; attempt < 100 && named_temp_.empty(); ++attempt) {
             const std::string name = next_temp_name(path_);
+            // The name exists until the rename below; a kill in between leaves it to the cleaner.
+            remove_when_process_ends(name);
             if (::linkat(AT_FDCWD, proc.c_str(), AT_FDCWD, name.c_str(), AT_SYMLINK_FOLLOW) == 0)
                 named_temp_ = name;
             else if (errno != EEXIST)

@@ -1,6 +1,8 @@
 // Output files written in full or not at all. The bytes go to an unnamed file in the target's directory
-// (O_TMPFILE; a hidden temporary where the file system lacks it) that commit() renames over the target:
-// a run that fails, is killed or fills the disk leaves the previous file as it was and no partial one.
+// (O_TMPFILE; a hidden temporary where the file system lacks it) that commit() names and renames over the
+// target: a run that fails, is killed or fills the disk leaves the previous file as it was and no partial
+// one. A named temporary is handed to the process's cleaner (support/process_cleaner.hpp) before it exists,
+// so that a kill at any moment leaves nothing beside the target once the process is gone.
 // Used by every writer of user-visible outputs (pictures, meshes, compiled models, headers).
 #pragma once
 

@@ -9,6 +9,7 @@
 #include "backend/llvm/jit.hpp"
 #include "backend/llvm/pipeline.hpp"
 #include "support/atomic_file.hpp"
+#include "support/process_cleaner.hpp"
 
 #include <cerrno>
 #include <cstdlib>
@@ -86,7 +87,8 @@ std::string find_archive(const std::string& name) {
 
 // A fresh private directory for intermediate files, removed on scope exit -- and when this process is
 // killed: a cleaner process (sh) waits for the end of a pipe that only this process and the tools it runs
-// hold open, then removes the directory. No destructor runs on SIGKILL; the pipe closes all the same.
+// hold open, then removes the directory (support::spawn_cleaner). No destructor runs on SIGKILL; the pipe
+// closes all the same.
 class TempDir {
 public:
     TempDir() {
@@ -115,19 +117,10 @@ private:
         if (pipe2(fds, O_CLOEXEC) != 0) return; // no cleaner: the destructor still removes the directory
         // The write end is inherited by the tools (ld, objcopy, c++): the directory outlives them.
         (void)fcntl(fds[1], F_SETFD, 0);
-        posix_spawn_file_actions_t actions;
-        posix_spawn_file_actions_init(&actions);
-        posix_spawn_file_actions_adddup2(&actions, fds[0], STDIN_FILENO);
-        posix_spawn_file_actions_addclose(&actions, fds[1]);
-        const std::string dir = path_.string();
-        const char* argv[] = {
-            "sh",        "-c",   "cat >/dev/null; exec rm -rf -- \"$1\"", "frac-compile-cleanup",
-            dir.c_str(), nullptr};
-        pid_t pid = 0;
-        const int err = posix_spawnp(&pid, "sh", &actions, nullptr, const_cast<char* const*>(argv), environ);
-        posix_spawn_file_actions_destroy(&actions);
+        const pid_t pid = support::spawn_cleaner(fds[0], "cat >/dev/null; exec rm -rf -- \"$1\"",
+                                                 "frac-compile-cleanup", {path_.string()});
         ::close(fds[0]);
-        if (err != 0) {
+        if (pid < 0) {
             ::close(fds[1]);
             return;
         }

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Outputs are atomic: frac render, mesh and compile killed (SIGKILL) at random moments leave at each
-# output path either the old complete file or a complete new one, no temporary file beside it, and (for
-# compile) no temporary directory. The verdict does not depend on when the kill lands; the moments only
+# output path either the old complete file or a complete new one, no temporary file beside it once the
+# process is gone (its cleaner removes a name killed between creation and rename), and (for compile) no
+# temporary directory. The verdict does not depend on when the kill lands; the moments only
 # vary which phase (compiling, subdividing, writing) is interrupted.
 # Usage: kill_outputs.sh FRAC EXAMPLES_DIR WORK_DIR [RUNS]
 set -u
@@ -68,14 +69,15 @@ trial() {
                 fail "$*: killed after ${delay} ms: $out is neither the old file nor the new one"
             fi
         done
-        # Only the outputs, the old files and the references: no temporary beside them.
-        stray=$(find . -name '.*' -type f)
-        [ -z "$stray" ] || fail "$*: killed after ${delay} ms: temporaries left: $stray"
-        # The compile's cleaner removes its directory once the process and its tools are gone.
+        # Only the outputs, the old files and the references: no temporary beside them. A temporary has a
+        # name only for the span of a few system calls; one killed there is removed by the process's
+        # cleaner once the process is gone, as the compile's directory is once the process and its tools are.
         for ((waited = 0; waited < 100; waited++)); do
-            [ -z "$(ls -A "$TMPDIR")" ] && break
+            stray=$(find . -name '.*' -type f)
+            [ -z "$stray" ] && [ -z "$(ls -A "$TMPDIR")" ] && break
             sleep 0.1
         done
+        [ -z "$stray" ] || fail "$*: killed after ${delay} ms: temporaries left: $stray"
         [ -z "$(ls -A "$TMPDIR")" ] || fail "$*: killed after ${delay} ms: left in TMPDIR: $(ls -A "$TMPDIR")"
     done
 }
