@@ -31,7 +31,7 @@ pid_t spawn_cleaner(int input, const std::string& script, const std::string& nam
     argv.push_back(nullptr);
     pid_t pid = 0;
     const int err =
-        posix_spawnp(&pid, "sh", &actions, nullptr, const_cast<char* const*>(argv.data()), environ);
+        posix_spawn(&pid, "/bin/sh", &actions, nullptr, const_cast<char* const*>(argv.data()), environ);
     posix_spawn_file_actions_destroy(&actions);
     return err == 0 ? pid : -1;
 }

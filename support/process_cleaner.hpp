@@ -9,7 +9,7 @@
 
 namespace frac::support {
 
-// Starts `sh -c SCRIPT NAME ARGS...` with `input` as its standard input, its output discarded and no
+// Starts `/bin/sh -c SCRIPT NAME ARGS...` with `input` as its standard input, its output discarded and no
 // other descriptor of this process, ignoring the terminal's signals. Returns its pid, or -1.
 pid_t spawn_cleaner(int input, const std::string& script, const std::string& name,
                     const std::vector<std::string>& args);
