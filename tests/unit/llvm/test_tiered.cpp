@@ -182,7 +182,7 @@ TEST_CASE("covers with checkpoints are the same on any threads and in every run"
         compile("shape s(x, y) over [-3, 3] × [-3, 3] = sin(3 * x) * cos(2 * y) + exp(x / 4) - 1.2;");
     const ir::Tape& tape = only_tape(m);
     rt::RssOptions o;
-    o.depth = 12;
+    o.depth = 13;
     o.keep_cells = true;
     std::vector<rt::RssResult> covers;
     for (int threads : {1, 2, 2, 1}) {
