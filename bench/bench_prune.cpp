@@ -1,6 +1,7 @@
 // Min/max pruning per region and adaptive series truncation, every variant measured in this one run:
 //  1. the constants of the pruning rule (ir/specialize.hpp): evaluation time per unit of tape cost,
-//     and the JIT's compile time of pruned tapes against their size (least squares);
+//     and the JIT's compile time of pruned tapes against their size (least squares); the fixed part
+//     of an evaluation in a cover (the JIT's without pruning, the interpreter's with it);
 //  2. RSS covers of CSG shapes with pruning off and on, with both engines: time, cells evaluated
 //     with a pruned function, cache hits, compiles and the time they took, and whether the covers
 //     are identical (they must be);
@@ -173,9 +174,12 @@ int main(int argc, char** argv) {
         return 1;
     }
     std::vector<Shape> shapes = {
-        load("bench/csg_scene.frac", "csg_scene", From::file), load("koch", "double_koch", From::module),
+        load("bench/csg_scene.frac", "csg_scene", From::file),
+        load("koch", "double_koch", From::module),
         load("examples/menger_frame.frac", "sponge_in_frame", From::file),
         load("fractals", "carpet", From::module), // no min/max outside its series: nothing to prune
+        // a short tape: the JIT's evaluation is mostly its fixed part, its pruning cannot pay
+        load("bench/kernel_scenes.frac", "sphere_box_csg", From::file),
     };
     const Shape& scene = shapes[0];
     std::string json = "{\n";
@@ -268,6 +272,61 @@ int main(int argc, char** argv) {
                     "\"flat_interp_eval_ns_fixed\": {:.3f}, \"flat_interp_eval_ns_per_cost\": {:.5f}}},\n",
                     pruned.size(), compile_fixed, compile_per_instr, interp_make_us, jit_ns0, jit_ns_per_cost,
                     tape_interp_ns0, tape_interp_ns_per_cost, flat_ns0, flat_ns_per_cost);
+
+    // ---- 1b. The fixed part of an evaluation in a cover ----
+    // What a cover pays per evaluation apart from the tape's instructions: the JIT's on its whole tape
+    // (no pruning; the generated code builds and classifies the cells), the interpreter's with
+    // pruning (a parent's few children per call, boxes built by the cover, tape pushes below): the
+    // cover's time per evaluation less the per-cost time of part 1 times its mean cost (flat tapes:
+    // cost = instructions). In the constants' unit they are jit_prune_costs.eval_ns_fixed and
+    // interp::cover_eval_ns_fixed, which decide whether a short pruned tape is worth running on the
+    // interpreter, and whether the JIT records choices at all.
+    const double unit = jit::jit_prune_costs.eval_ns_per_cost / jit_ns_per_cost; // ns -> constants' unit
+    fmt::print("\nFixed part of an evaluation in a cover (one thread; constants' unit: ns x {:.2f})\n", unit);
+    fmt::print("  {:<16} {:>5} {:>6} {:>9} {:>10} {:>10} {:>12} {:>10} {:>10} {:>12}\n", "shape", "depth",
+               "cost", "boxes", "jit ns/ev", "jit fixed", "(in unit)", "interp ns", "mean cost",
+               "interp fixed");
+    const Shape kernel_csg = load("bench/kernel_scenes.frac", "sphere_box_csg", From::file);
+    const Shape flat_100 = load(bench::large_model(100).source, bench::large_model(100).name, From::text);
+    std::vector<double> jit_fixed_units, interp_fixed_units;
+    json += "  \"cover_fixed\": [\n";
+    for (const Shape* s : {&kernel_csg, &flat_100, &flat_model}) {
+        const int d = s->dimension == 2 ? 9 : depth_3d;
+        ir::EvalOptions off, on;
+        off.prune = false;
+        Run jit_run, interp_run;
+        for (int r = 0; r < 3; ++r) {
+            cover_once(make_jit, *s, d, off, jit_run);
+            cover_once(make_interp, *s, d, on, interp_run);
+        }
+        const double n = double(jit_run.result.evaluated);
+        double instructions = 0;
+        for (const rt::PruneLevel& pl : interp_run.result.prune_levels) instructions += pl.instructions;
+        const double mean_cost = instructions / double(interp_run.result.evaluated);
+        const double jit_ns = 1e9 * jit_run.seconds / n;
+        const double interp_ns = 1e9 * interp_run.seconds / double(interp_run.result.evaluated);
+        const double jit_fixed = jit_ns - jit_ns_per_cost * ir::tape_cost(s->tape);
+        const double interp_fixed = interp_ns - flat_ns_per_cost * mean_cost;
+        jit_fixed_units.push_back(unit * jit_fixed);
+        interp_fixed_units.push_back(unit * interp_fixed);
+        fmt::print("  {:<16} {:>5} {:>6.0f} {:>9} {:>10.1f} {:>10.1f} {:>12.0f} {:>10.1f} {:>10.1f} {:>6.1f} "
+                   "({:.0f})\n",
+                   s->name, d, ir::tape_cost(s->tape), jit_run.result.evaluated, jit_ns, jit_fixed,
+                   unit * jit_fixed, interp_ns, mean_cost, interp_fixed, unit * interp_fixed);
+        json += fmt::format("{}    {{\"shape\": \"{}\", \"depth\": {}, \"cost\": {:.1f}, \"jit_ns\": {:.3f}, "
+                            "\"jit_fixed_ns\": {:.3f}, \"interp_pruned_ns\": {:.3f}, \"mean_cost\": {:.3f}, "
+                            "\"interp_fixed_ns\": {:.3f}, \"unit\": {:.4f}}}",
+                            s == &kernel_csg ? "" : ",\n", s->name, d, ir::tape_cost(s->tape), jit_ns,
+                            jit_fixed, interp_ns, mean_cost, interp_fixed, unit);
+    }
+    json += "\n  ],\n";
+    // The JIT's fixed part shows on the short tape (on long ones it is lost in the error of the slope);
+    // the interpreter's is the least over the shapes.
+    fmt::print(
+        "  fixed part, constants' unit: JIT on the short tape {:.0f} (in use {:.0f}), interpreter at least "
+        "{:.0f} (in use {:.0f})\n",
+        jit_fixed_units.front(), jit::jit_prune_costs.eval_ns_fixed,
+        *std::min_element(interp_fixed_units.begin(), interp_fixed_units.end()), interp::cover_eval_ns_fixed);
 
     // ---- 2. Covers with pruning off and on ----
     fmt::print(

@@ -413,6 +413,17 @@ std::size_t SpecializationCache::size() const {
     return compiled_count_;
 }
 
+bool SpecializationCache::may_pay(double cost_current, double expected_evaluations, double record_ns) const {
+    const double own = eval_ns(costs_, cost_current);
+    double best = expected_evaluations * costs_.eval_ns_per_cost * cost_current - costs_.compile_ns_fixed;
+    if (fallback_ && fallback_eval_ns_)
+        best = std::max(best, expected_evaluations * (own - fallback_ns_fixed_));
+    std::lock_guard<std::mutex> lock(mu_);
+    if (compiled_count_ > 0)
+        best = std::max(best, expected_evaluations * costs_.eval_ns_per_cost * cost_current);
+    return best > record_ns;
+}
+
 std::shared_ptr<Evaluator> SpecializationCache::get(const Tape& current, const std::vector<Choice>& choices,
                                                     double expected_evaluations, SpecializeStats& stats) {
     if (!any_decided(choices)) {
@@ -457,8 +468,7 @@ std::shared_ptr<Evaluator> SpecializationCache::get(const Tape& current, const s
         entry.fallback.reset();
         return entry.compiled;
     }
-    if (fallback_ && fallback_ns_per_cost_ &&
-        fallback_ns_per_cost_(pruned) * after < costs_.eval_ns_per_cost * before) {
+    if (fallback_ && fallback_eval_ns_ && fallback_eval_ns_(pruned) < eval_ns(costs_, before)) {
         if (entry.fallback) {
             ++stats.hits;
         } else {

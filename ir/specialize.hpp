@@ -115,7 +115,14 @@ struct PruneCosts {
     double eval_ns_per_cost = 1;           // evaluation time per unit of tape_cost, per box
     double compile_ns_fixed = 0;           // compiling a specialised tape: fixed part ...
     double compile_ns_per_instruction = 0; // ... and per instruction of the pruned tape
+    // Time per evaluation in a cover apart from the tape's instructions (the call, the cell's box,
+    // its verdict), in the unit of eval_ns_per_cost: what a short pruned tape cannot save.
+    double eval_ns_fixed = 0;
 };
+// Time per evaluation in a cover of a tape of cost `cost`.
+inline double eval_ns(const PruneCosts& c, double cost) {
+    return c.eval_ns_fixed + c.eval_ns_per_cost * cost;
+}
 
 // The rule (docs/design.md). A pruned tape is used when
 //   cost(pruned) <= max_cost_ratio * cost(current),
@@ -125,8 +132,9 @@ struct PruneCosts {
 //   demand * eval_ns_per_cost * (cost(current) - cost(pruned)) >= compile_ns_fixed
 //                                             + compile_ns_per_instruction * instructions(pruned).
 // Until then an engine with a cheaper second tier (the JIT: the interpreter, no compile time) uses
-// it when that evaluates the pruned tape faster than the engine evaluates the current one:
-//   fallback_ns_per_cost * cost(pruned) < eval_ns_per_cost * cost(current).
+// it when that evaluates the pruned tape faster, in a cover, than the engine evaluates the current one:
+//   fallback_eval_ns(pruned) < eval_ns(costs, cost(current)),
+// the fallback's time including its fixed part per evaluation (and its own pushes below).
 inline constexpr double max_cost_ratio = 0.9;
 // The rule of an engine that runs a pruned tape without compiling it (the interpreter, and the
 // JIT's second tier): a tape push pays when the expected evaluations of the sub-boxes save more than
@@ -147,12 +155,22 @@ public:
     using Compile = std::function<std::unique_ptr<Evaluator>(const Tape&)>;
     using CostOf = std::function<double(const Tape&)>;
     // `fallback` (optional) makes the second tier's evaluator of a tape, whose results are the
-    // engine's bit for bit; `fallback_ns_per_cost` gives its evaluation time per unit of a tape's cost
-    // (the interpreter's depends on the tape: flat or not); without it the fallback is never used.
+    // engine's bit for bit; `fallback_eval_ns` gives its time per evaluation of a tape in a cover
+    // (the interpreter's depends on the tape: flat or not), and `fallback_ns_fixed` the least of it
+    // (an empty tape's); without them the fallback is never used.
     SpecializationCache(Compile compile, PruneCosts costs, Compile fallback = {},
-                        CostOf fallback_ns_per_cost = {})
+                        CostOf fallback_eval_ns = {}, double fallback_ns_fixed = 0)
         : compile_(std::move(compile)), fallback_(std::move(fallback)), costs_(costs),
-          fallback_ns_per_cost_(fallback_ns_per_cost) {}
+          fallback_eval_ns_(std::move(fallback_eval_ns)), fallback_ns_fixed_(fallback_ns_fixed) {}
+
+    // Whether recording the choices over a box of a tape of cost `cost_current`, which costs
+    // `record_ns` (in the unit of eval_ns_per_cost), can pay at all for a cell with
+    // `expected_evaluations` descendant evaluations: the best a pruned tape could save them (an empty
+    // one, compiled for this demand alone or run by the fallback, whose fixed part stays) is more than
+    // the recording, or a compiled specialisation exists already (the recording may find it). Where
+    // none holds every request would be declined after its recording was paid for: short tapes, whose
+    // evaluation by the JIT is mostly its fixed part.
+    bool may_pay(double cost_current, double expected_evaluations, double record_ns) const;
 
     // Applies the rule to the choices recorded on `current`'s box; returns the specialised evaluator
     // (shared: clone it for another thread) or null. Counts what happened in `stats`.
@@ -169,7 +187,8 @@ private:
     };
     Compile compile_, fallback_;
     PruneCosts costs_;
-    CostOf fallback_ns_per_cost_;
+    CostOf fallback_eval_ns_;
+    double fallback_ns_fixed_;
     mutable std::mutex mu_; // held while compiling, so no tape is compiled twice
     std::map<std::string, Entry> entries_;
     std::size_t compiled_count_ = 0;

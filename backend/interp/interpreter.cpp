@@ -343,6 +343,10 @@ double eval_ns_per_cost(const ir::Tape& tape) {
     return runs_flat(tape) ? flat_eval_ns_per_cost : tape_eval_ns_per_cost;
 }
 
+double cover_eval_ns(const ir::Tape& tape) {
+    return cover_eval_ns_fixed + eval_ns_per_cost(tape) * ir::tape_cost(tape);
+}
+
 std::unique_ptr<ir::Evaluator> make_tape_interpreter(ir::Tape tape, const ir::EvalOptions& options) {
     return std::make_unique<Interpreter>(std::move(tape), options);
 }

@@ -28,10 +28,20 @@ inline constexpr double tape_eval_ns_per_cost = 33.0;
 // That of the interpreter make_interpreter picks for `tape`.
 double eval_ns_per_cost(const ir::Tape& tape);
 
+// What an evaluation of a pruned tape costs the interpreter in a cover apart from the tape's
+// instructions (in the unit of the constants above): the call on a parent's few children at a time,
+// the cell's box, its verdict and the pushes below it (bench/bench_prune part 2 measures it from
+// pruned covers; docs/performance.md "The second tier's fixed cost").
+inline constexpr double cover_eval_ns_fixed = 260.0;
+// Time per evaluation of `tape` in a pruned cover: the fixed part and the tape's.
+double cover_eval_ns(const ir::Tape& tape);
+
 // What specialising costs the interpreter (a tape copy, no compilation), measured by bench/bench_prune;
 // its evaluation time is the tape interpreter's (eval_ns_per_cost tells a flat tape's).
-inline constexpr ir::PruneCosts interp_prune_costs{tape_eval_ns_per_cost, /*compile_ns_fixed=*/2000.0,
-                                                   /*compile_ns_per_instruction=*/0.0};
+inline constexpr ir::PruneCosts interp_prune_costs{.eval_ns_per_cost = tape_eval_ns_per_cost,
+                                                   .compile_ns_fixed = 2000.0,
+                                                   .compile_ns_per_instruction = 0.0,
+                                                   .eval_ns_fixed = cover_eval_ns_fixed};
 
 // Recording the choices over a box and building the pruned tape cost about as much as the 4
 // children of a 2D cell one level above the depth could save (bench/bench_large: 3.3 µs per

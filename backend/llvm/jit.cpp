@@ -225,6 +225,10 @@ public:
             return nullptr;
         auto cache = cache_.lock();
         if (!cache) return nullptr;
+        if (cost_ < 0) cost_ = ir::tape_cost(code_->tape);
+        // A recording is an evaluation by the tape interpreter.
+        if (!cache->may_pay(cost_, expected_evaluations, interp::tape_eval_ns_per_cost * cost_))
+            return nullptr;
         const auto t0 = Clock::now();
         if (!recorder_) recorder_ = std::make_unique<interp::ChoiceRecorder>(code_->tape, code_->options);
         const std::vector<ir::Choice> choices = recorder_->record(box);
@@ -317,6 +321,7 @@ private:
     std::weak_ptr<ir::SpecializationCache> cache_;
     std::shared_ptr<ir::SpecializationCache> owned_cache_; // the root of a family owns the cache
     std::unique_ptr<interp::ChoiceRecorder> recorder_;
+    double cost_ = -1; // ir::tape_cost of the tape, once asked
 };
 
 } // namespace
@@ -428,7 +433,7 @@ std::unique_ptr<ir::Evaluator> make_jit(const ir::Tape& tape, const ir::EvalOpti
         // Until a pruned tape has earned its compile time, the interpreter runs it when that is faster
         // than the JIT running the whole tape; its enclosures are the JIT's bit for bit.
         [options](const ir::Tape& t) { return interp::make_interpreter(t, options); },
-        [](const ir::Tape& t) { return interp::eval_ns_per_cost(t); });
+        [](const ir::Tape& t) { return interp::cover_eval_ns(t); }, interp::cover_eval_ns_fixed);
     *self = cache;
     root->own_cache(std::move(cache));
     return root;

@@ -67,13 +67,18 @@ std::unique_ptr<ir::Evaluator> make_jit(const ir::Tape& tape, const ir::EvalOpti
 
 // What specialising costs and saves with the JIT (ir/specialize.hpp), measured by bench/bench_prune:
 // evaluation time per unit of tape cost and box, compile time of a pruned tape.
-inline constexpr ir::PruneCosts jit_prune_costs{/*eval_ns_per_cost=*/0.8, /*compile_ns_fixed=*/2.0e7,
-                                                /*compile_ns_per_instruction=*/2.0e6};
+// Its fixed part per evaluation in a cover (the generated code builds and classifies the cells) is
+// measured by bench/bench_prune part 2 like the interpreter's cover_eval_ns_fixed.
+inline constexpr ir::PruneCosts jit_prune_costs{.eval_ns_per_cost = 0.8,
+                                                .compile_ns_fixed = 2.0e7,
+                                                .compile_ns_per_instruction = 2.0e6,
+                                                .eval_ns_fixed = 45.0};
 
 // Recording the choices over a box is an interpreter evaluation of the whole tape, 10-30 JIT
 // evaluations: the JIT records only for a cell with at least this many expected descendant
 // evaluations (in 2D, 5 levels above the depth; measured in docs/performance.md, "Min/max pruning").
-// Its second tier (pruned tapes on the interpreter) records at every level.
+// Its second tier (pruned tapes on the interpreter) records at every level. Nor does it record where
+// no outcome could repay it (ir::SpecializationCache::may_pay: short tapes).
 inline constexpr double jit_min_expected_evaluations = 120;
 
 // What compiling one tape cost (wall clock, milliseconds), for benchmarks and --verbose output.

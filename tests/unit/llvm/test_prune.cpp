@@ -172,15 +172,20 @@ TEST_CASE("the JIT declines to compile a pruned tape that would not repay it", "
     CHECK_FALSE(jt->specialize(box.data(), 1));
     CHECK(jt->specialize_stats.requests == 0);
     CHECK_FALSE(jt->specialize(box.data(), jit::jit_min_expected_evaluations));
-    CHECK(jt->specialize_stats.declined == 1);
+    // Where the interpreter's fixed part alone costs more than the JIT's evaluation of the scene, no
+    // pruned tape can pay either: the choices are not even recorded.
+    const bool fallback_may_pay =
+        interp::cover_eval_ns_fixed < ir::eval_ns(jit::jit_prune_costs, ir::tape_cost(tape));
+    CHECK(jt->specialize_stats.requests == (fallback_may_pay ? 1 : 0));
+    CHECK(jt->specialize_stats.declined == (fallback_may_pay ? 1 : 0));
     CHECK(jt->specialize_stats.compiled == 0);
     // Where only the disk is left, the interpreter runs the small pruned tape when the rule says
     // that is faster than the JIT on the whole scene.
     const std::vector<Interval> disk_box{{0.98, 1.02}, {0.48, 0.52}};
     interp::ChoiceRecorder rec(tape, {});
     const ir::Tape disk_only = ir::specialize(tape, rec.record(disk_box.data()));
-    const bool interp_faster = interp::eval_ns_per_cost(disk_only) * ir::tape_cost(disk_only) <
-                               jit::jit_prune_costs.eval_ns_per_cost * ir::tape_cost(tape);
+    const bool interp_faster =
+        interp::cover_eval_ns(disk_only) < ir::eval_ns(jit::jit_prune_costs, ir::tape_cost(tape));
     auto tier2 = jt->specialize(disk_box.data(), jit::jit_min_expected_evaluations);
     CHECK(bool(tier2) == interp_faster);
     if (tier2) {
@@ -189,6 +194,57 @@ TEST_CASE("the JIT declines to compile a pruned tape that would not repay it", "
         CHECK(jt->specialize_stats.fallbacks == 1);
         CHECK(same(tier2->eval_box(disk_box.data()), jt->eval_box(disk_box.data())));
     }
+}
+
+TEST_CASE("the JIT records no choices where no outcome could repay the recording", "[llvm][prune]") {
+    // Three balls: a short tape. The JIT's evaluation of it is mostly its fixed part, which the
+    // interpreter's fixed part alone exceeds, and the cells of a cover do not demand enough to repay a
+    // compile: every request would be declined after its recording was paid for.
+    const Model m = compile(R"(
+import "csg";
+shape balls(x, y, z) over [-2, 2] × [-2, 2] × [-2, 2] =
+    min(sphere((x, y, z), (-1, 0, 0), 0.5), sphere((x, y, z), (1, 0, 0), 0.5), sphere((x, y, z), (0, 1, 0), 0.5));
+)");
+    const ir::Tape& tape = tape_of(m, "balls");
+    const double cost = ir::tape_cost(tape);
+    REQUIRE(interp::cover_eval_ns_fixed >= ir::eval_ns(jit::jit_prune_costs, cost));
+    auto jt = JitEngine::make(tape);
+    // Around the left ball only the left ball matters: the interpreter would prune there.
+    const std::vector<Interval> box{{-1.6, -0.4}, {-0.6, 0.6}, {-0.6, 0.6}};
+    auto in = InterpEngine::make(tape);
+    CHECK(in->specialize(box.data(), 1e4));
+    const double few = 1e4; // a deep cell's descendants: far from repaying a 20 ms compile
+    REQUIRE(few * jit::jit_prune_costs.eval_ns_per_cost * cost < jit::jit_prune_costs.compile_ns_fixed);
+    CHECK_FALSE(jt->specialize(box.data(), few));
+    CHECK(jt->specialize_stats.requests == 0); // not even recorded
+    // A cell whose descendants alone would repay compiling: asked, recorded, compiled.
+    auto compiled = jt->specialize(box.data(), 1e12);
+    CHECK(jt->specialize_stats.requests == 1);
+    REQUIRE(compiled);
+    CHECK(compiled->engine() == "jit");
+    CHECK(compiled->instruction_count() < tape.instruction_count());
+    // The rule itself: a long tape is worth recording for the fallback, a short one is not.
+    ir::SpecializationCache cache(
+        [](const ir::Tape&) -> std::unique_ptr<ir::Evaluator> { return nullptr; }, jit::jit_prune_costs,
+        [](const ir::Tape& t) { return interp::make_interpreter(t); },
+        [](const ir::Tape& t) { return interp::cover_eval_ns(t); }, interp::cover_eval_ns_fixed);
+    const auto record = [](double c) { return interp::tape_eval_ns_per_cost * c; };
+    CHECK_FALSE(cache.may_pay(cost, few, record(cost)));
+    CHECK(cache.may_pay(cost, 1e12, record(cost)));
+    // A tape long enough for the interpreter to run an empty pruned tape faster, and a demand that
+    // repays no compile of it: only the fallback can pay, and an engine without one does not record.
+    const double per_cost = jit::jit_prune_costs.eval_ns_per_cost;
+    const double long_cost = 2 * interp::cover_eval_ns_fixed / per_cost;
+    const double some = 0.5 * jit::jit_prune_costs.compile_ns_fixed / (per_cost * long_cost);
+    CHECK(cache.may_pay(long_cost, some, record(long_cost)));
+    ir::SpecializationCache no_fallback(
+        [](const ir::Tape&) -> std::unique_ptr<ir::Evaluator> { return nullptr; }, jit::jit_prune_costs);
+    CHECK_FALSE(no_fallback.may_pay(long_cost, some, record(long_cost)));
+    CHECK(no_fallback.may_pay(long_cost, 4 * some, record(long_cost)));
+    // Too few descendants to repay the recording even if they all ran an empty tape on the fallback.
+    const double saved_each = ir::eval_ns(jit::jit_prune_costs, long_cost) - interp::cover_eval_ns_fixed;
+    CHECK_FALSE(cache.may_pay(long_cost, 0.9 * record(long_cost) / saved_each, record(long_cost)));
+    CHECK(cache.may_pay(long_cost, 1.1 * record(long_cost) / saved_each, record(long_cost)));
 }
 
 TEST_CASE("the second tier's evaluation cost is that of the interpreter running the pruned tape",
@@ -370,8 +426,11 @@ TEMPLATE_TEST_CASE("a 3D CSG cover is the same with and without pruning", "[llvm
     const rt::RssResult a = rt::subdivide(*plain, s.box, o);
     const rt::RssResult b = rt::subdivide(*pruning, s.box, o);
     CHECK(rt::same_cover(a, b));
-    CHECK(pruning->specialize_stats.requests > 0);
-    if (std::string(TestType::name) == "interp") CHECK(b.pruned_evaluations > 0);
+    // The JIT records only where a pruned tape could repay it (tested above): not on this short tape.
+    if (std::string(TestType::name) == "interp") {
+        CHECK(pruning->specialize_stats.requests > 0);
+        CHECK(b.pruned_evaluations > 0);
+    }
 }
 
 TEST_CASE("a large model's tapes shrink down the tree, and its cover stays the same", "[llvm][prune][rss]") {
