@@ -5,7 +5,9 @@
 // JSON.
 //
 //   bench_jit [depth=10] [large_depth=12] [json=bench_jit.json] [depth_3d=6]
-//   bench_jit --first-compile SHAPE   (the fresh process: JIT initialisation and compile ms, with phases)
+//   bench_jit --first-compile SHAPE [fast]   (the fresh process: JIT initialisation and compile ms, with
+//                                             phases; `fast`: LLVM's fast machine code generation, the
+//                                             tiered engine's first compile)
 #include "backend/interp/interpreter.hpp"
 #include "backend/llvm/jit.hpp"
 #include "backend/llvm/tiered.hpp"
@@ -104,7 +106,7 @@ bool stdlib_shapes(std::vector<Shape>& shapes) {
 // `bench_jit --first-compile SHAPE`: in this fresh process, the JIT's initialisation and then the first
 // compile of SHAPE, in ms ("INIT COMPILE", then the compile's phases): the latency a user's first
 // `frac render --engine jit` pays.
-int first_compile(const std::string& name) {
+int first_compile(const std::string& name, bool fast) {
     std::vector<Shape> shapes;
     if (!stdlib_shapes(shapes)) return 1;
     for (const Shape& s : shapes) {
@@ -117,7 +119,9 @@ int first_compile(const std::string& name) {
         }
         const double init_ms = 1e3 * seconds_since(t0);
         const auto t1 = Clock::now();
-        auto e = jit::make_jit(s.tape);
+        jit::JitConfig config;
+        config.fast_codegen = fast;
+        auto e = jit::make_jit(s.tape, {}, config);
         const double compile_ms = 1e3 * seconds_since(t1);
         const jit::CompileInfo& ci = *jit::compile_info(*e);
         fmt::print("{:.3f} {:.3f} tables {:.2f} codegen {:.2f} optimise {:.2f} machine {:.2f}\n", init_ms,
@@ -130,11 +134,12 @@ int first_compile(const std::string& name) {
 
 // The first compile of `name` in a fresh process (this program run with --first-compile), as
 // {init, compile} ms; {-1, -1} when it failed.
-std::pair<double, double> one_fresh_compile(const std::string& name) {
+std::pair<double, double> one_fresh_compile(const std::string& name, bool fast) {
     std::array<char, 4096> self{};
     const ssize_t n = ::readlink("/proc/self/exe", self.data(), self.size() - 1);
     if (n <= 0) return {-1, -1};
-    const std::string command = fmt::format("'{}' --first-compile '{}'", std::string(self.data(), n), name);
+    const std::string command =
+        fmt::format("'{}' --first-compile '{}'{}", std::string(self.data(), n), name, fast ? " fast" : "");
     std::FILE* child = ::popen(command.c_str(), "r");
     if (!child) return {-1, -1};
     double init = -1, compile = -1;
@@ -143,10 +148,10 @@ std::pair<double, double> one_fresh_compile(const std::string& name) {
 }
 
 // The median of three fresh processes: single ones spread by 2x on a shared machine.
-std::pair<double, double> fresh_first_compile(const std::string& name) {
+std::pair<double, double> fresh_first_compile(const std::string& name, bool fast) {
     std::vector<std::pair<double, double>> runs;
     for (int rep = 0; rep < 3; ++rep) {
-        runs.push_back(one_fresh_compile(name));
+        runs.push_back(one_fresh_compile(name, fast));
         if (runs.back().second < 0) return runs.back();
     }
     std::sort(runs.begin(), runs.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
@@ -156,7 +161,8 @@ std::pair<double, double> fresh_first_compile(const std::string& name) {
 } // namespace
 
 int main(int argc, char** argv) {
-    if (argc == 3 && std::string(argv[1]) == "--first-compile") return first_compile(argv[2]);
+    if ((argc == 3 || argc == 4) && std::string(argv[1]) == "--first-compile")
+        return first_compile(argv[2], argc == 4 && std::string(argv[3]) == "fast");
     const int depth = argc > 1 ? std::atoi(argv[1]) : 10;
     const int large = argc > 2 ? std::atoi(argv[2]) : 12;
     const std::string json_path = argc > 3 ? argv[3] : "bench_jit.json";
@@ -185,8 +191,9 @@ int main(int argc, char** argv) {
     // ---- 1. LLVM compile time per shape: the first compile (which also warms LLVM up) and the best of three
     // ----
     fmt::print("LLVM compile time per shape (ms; JIT initialisation once: {:.1f} ms)\n", init_ms);
-    fmt::print("{:<20} {:>6} {:>9} {:>8} {:>8} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8}\n", "shape", "instrs",
-               "total", "tables", "codegen", "optimise", "machine", "first", "IR ops", "cached", "fresh");
+    fmt::print("{:<20} {:>6} {:>9} {:>8} {:>8} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8} {:>8} {:>8} {:>10}\n",
+               "shape", "instrs", "total", "tables", "codegen", "optimise", "machine", "first", "IR ops",
+               "cached", "fresh", "fast", "f.mach", "fresh fast");
     // `cached`: the same compile with the object loaded from the on-disk cache (backend/llvm/code_cache.hpp),
     // as a later process finds it; best of three.
     const std::filesystem::path cache_dir =
@@ -201,8 +208,10 @@ int main(int argc, char** argv) {
     std::string worst_shape;
     // `fresh`: the first compile in a fresh process of its own, median of three (JIT initialisation apart,
     // printed once).
-    double worst_fresh = 0, fresh_init = 0;
-    std::string worst_fresh_shape;
+    // `fast`, `f.mach`: the same compile with LLVM's fast machine code generation (best of three; total
+    // and machine code ms), and `fresh fast` in a fresh process: the tiered engine's first compile.
+    double worst_fresh = 0, fresh_init = 0, worst_fresh_fast = 0, machine_sum = 0, fast_machine_sum = 0;
+    std::string worst_fresh_shape, worst_fresh_fast_shape;
     for (std::size_t i = 0; i < shapes.size(); ++i) {
         const Shape& s = shapes[i];
         const auto t0 = Clock::now();
@@ -215,6 +224,16 @@ int main(int argc, char** argv) {
             auto e = jit::make_jit(s.tape);
             if (jit::compile_info(*e)->total_ms < ci.total_ms) ci = *jit::compile_info(*e);
         }
+        jit::CompileInfo fast_ci;
+        fast_ci.total_ms = 1e300;
+        jit::JitConfig fast_config;
+        fast_config.fast_codegen = true;
+        for (int rep = 0; rep < 3; ++rep) {
+            auto e = jit::make_jit(s.tape, {}, fast_config);
+            if (jit::compile_info(*e)->total_ms < fast_ci.total_ms) fast_ci = *jit::compile_info(*e);
+        }
+        machine_sum += ci.machine_ms;
+        fast_machine_sum += fast_ci.machine_ms;
         (void)jit::make_jit(s.tape, {}, cached); // stores it
         double cached_ms = 1e300;
         for (int rep = 0; rep < 3; ++rep) {
@@ -229,8 +248,9 @@ int main(int argc, char** argv) {
             worst_cached = cached_ms;
             worst_cached_shape = s.name;
         }
-        const auto [init_ms_fresh, fresh_ms] = fresh_first_compile(s.name);
-        if (fresh_ms < 0) {
+        const auto [init_ms_fresh, fresh_ms] = fresh_first_compile(s.name, false);
+        const double fresh_fast_ms = fresh_first_compile(s.name, true).second;
+        if (fresh_ms < 0 || fresh_fast_ms < 0) {
             std::cerr << "bench_jit: the fresh-process compile of " << s.name << " failed\n";
             return 1;
         }
@@ -239,25 +259,41 @@ int main(int argc, char** argv) {
             worst_fresh = fresh_ms;
             worst_fresh_shape = s.name;
         }
+        if (fresh_fast_ms > worst_fresh_fast) {
+            worst_fresh_fast = fresh_fast_ms;
+            worst_fresh_fast_shape = s.name;
+        }
         if (ci.total_ms > worst_compile) {
             worst_compile = ci.total_ms;
             worst_shape = s.name;
         }
         fmt::print(
-            "{:<20} {:>6} {:>9.2f} {:>8.2f} {:>8.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>8} {:>8.2f} {:>8.2f}\n",
+            "{:<20} {:>6} {:>9.2f} {:>8.2f} {:>8.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>8} {:>8.2f} {:>8.2f} "
+            "{:>8.2f} {:>8.2f} {:>10.2f}\n",
             s.name, s.tape.instruction_count(), ci.total_ms, ci.tables_ms, ci.codegen_ms, ci.optimize_ms,
-            ci.machine_ms, first_ms, ci.ir_instructions, cached_ms, fresh_ms);
+            ci.machine_ms, first_ms, ci.ir_instructions, cached_ms, fresh_ms, fast_ci.total_ms,
+            fast_ci.machine_ms, fresh_fast_ms);
         json += fmt::format(
             "    {{\"shape\": \"{}\", \"tape_instructions\": {}, \"total_ms\": {:.3f}, \"tables_ms\": "
             "{:.3f}, "
             "\"codegen_ms\": {:.3f}, \"optimize_ms\": {:.3f}, \"machine_ms\": {:.3f}, \"first_ms\": {:.3f}, "
-            "\"ir_instructions\": {}, \"cached_ms\": {:.3f}, \"fresh_ms\": {:.3f}}}{}\n",
+            "\"ir_instructions\": {}, \"cached_ms\": {:.3f}, \"fresh_ms\": {:.3f}, \"fast_total_ms\": "
+            "{:.3f}, "
+            "\"fast_machine_ms\": {:.3f}, \"fresh_fast_ms\": {:.3f}}}{}\n",
             json_escape(s.name), s.tape.instruction_count(), ci.total_ms, ci.tables_ms, ci.codegen_ms,
             ci.optimize_ms, ci.machine_ms, first_ms, ci.ir_instructions, cached_ms, fresh_ms,
-            i + 1 < shapes.size() ? "," : "");
+            fast_ci.total_ms, fast_ci.machine_ms, fresh_fast_ms, i + 1 < shapes.size() ? "," : "");
     }
     std::filesystem::remove_all(cache_dir);
     json += "  ],\n";
+    // The tiered engine's rule (jit::optimize_after) takes the optimised compile as the fast one plus
+    // this many times its machine code time more.
+    const double extra_machine = fast_machine_sum > 0 ? machine_sum / fast_machine_sum - 1 : 0;
+    fmt::print(
+        "  machine code time, all shapes: optimised / fast = {:.2f}x (the optimised compile costs {:.2f} "
+        "fast machine code times more)\n",
+        machine_sum / fast_machine_sum, extra_machine);
+    json += fmt::format("  \"machine_optimised_over_fast\": {:.4f},\n", machine_sum / fast_machine_sum);
 
     // ---- 2. The carpet: RSS covers with the three engines ----
     auto in = interp::make_interpreter(carpet->tape);
@@ -317,18 +353,23 @@ int main(int argc, char** argv) {
         }
     }
     const std::size_t n_boxes = boxes.size() / 2;
-    std::vector<ir::Interval> oi, oj, o1, oh;
+    std::vector<ir::Interval> oi, oj, o1, oh, of;
+    jit::JitConfig fast_config;
+    fast_config.fast_codegen = true;
+    auto jf = jit::make_jit(carpet->tape, {}, fast_config); // the tiered engine's first code
     // Interleaved repetitions, the minimum of each: the machine is shared, and a disturbance then
     // hits every engine alike instead of one of them.
-    double t_in = 1e300, t_jit = 1e300, t_j1 = 1e300, t_hand = 1e300;
+    double t_in = 1e300, t_jit = 1e300, t_j1 = 1e300, t_hand = 1e300, t_fast = 1e300;
     for (int rep = 0; rep < 5; ++rep) {
         if (rep < 2) t_in = std::min(t_in, eval_all(*in, boxes, oi, 1));
         t_jit = std::min(t_jit, eval_all(*jt, boxes, oj, 3));
         t_j1 = std::min(t_j1, eval_all(*j1, boxes, o1, 3));
         t_hand = std::min(t_hand, eval_all(*hw, boxes, oh, 3));
+        t_fast = std::min(t_fast, eval_all(*jf, boxes, of, 3));
     }
-    std::size_t diff_jit = 0, diff_j1 = 0, diff_hand = 0;
+    std::size_t diff_jit = 0, diff_j1 = 0, diff_hand = 0, diff_fast = 0;
     for (std::size_t i = 0; i < n_boxes; ++i) {
+        diff_fast += !same(oj[i], of[i]);
         diff_jit += !same(oi[i], oj[i]);
         diff_j1 += !same(oi[i], o1[i]);
         diff_hand += !same(oi[i], oh[i]);
@@ -345,13 +386,20 @@ int main(int argc, char** argv) {
         "  JIT x1       {:>8.1f} ns/box   interpreter / JIT = {:.2f}x   JIT / hand-written = {:.3f}x\n",
         t_j1 * ns, t_in / t_j1, t_j1 / t_hand);
     fmt::print("  hand-written {:>8.1f} ns/box   (scalar C++, -O2 -march=native)\n", t_hand * ns);
+    const double carpet_cost = ir::tape_cost(carpet->tape);
+    fmt::print(
+        "  JIT, fast machine code {:>6.1f} ns/box   fast / optimised = {:.2f}x: {:.3f} ns per unit of tape "
+        "cost ({:.0f}) more; enclosures differing from the optimised code's: {}\n",
+        t_fast * ns, t_fast / t_jit, (t_fast - t_jit) * ns / carpet_cost, carpet_cost, diff_fast);
     fmt::print("  enclosures differing from the interpreter's: JIT {}, JIT x1 {}, hand-written {}\n",
                diff_jit, diff_j1, diff_hand);
     json += fmt::format(
         "  \"carpet_per_box\": {{\"depth\": {}, \"boxes\": {}, \"interp_ns\": {:.2f}, \"jit_ns\": {:.2f}, "
         "\"jit_scalar_ns\": {:.2f}, \"handwritten_ns\": {:.2f}, \"jit_mismatches\": {}, "
-        "\"jit_scalar_mismatches\": {}, \"handwritten_mismatches\": {}}},\n",
-        depth, n_boxes, t_in * ns, t_jit * ns, t_j1 * ns, t_hand * ns, diff_jit, diff_j1, diff_hand);
+        "\"jit_scalar_mismatches\": {}, \"handwritten_mismatches\": {}, \"jit_fast_codegen_ns\": {:.2f}, "
+        "\"fast_codegen_mismatches\": {}}},\n",
+        depth, n_boxes, t_in * ns, t_jit * ns, t_j1 * ns, t_hand * ns, diff_jit, diff_j1, diff_hand,
+        t_fast * ns, diff_fast);
 
     // ---- 4. Every stdlib shape: interpreter against JIT ----
     fmt::print("\nEvery stdlib shape, RSS cover (2D at depth {}, 3D at depth {})\n", depth, depth_3d);
@@ -397,17 +445,21 @@ int main(int argc, char** argv) {
                worst_shape, worst_compile < 50 ? "met" : "MISSED");
     fmt::print("  the same from the code cache (worst):            {:>7.2f} ms ({})   {:.1f}x faster\n",
                worst_cached, worst_cached_shape, worst_compile / worst_cached);
-    fmt::print(
-        "  first compile in a fresh process <= 50 ms (worst): {:>5.2f} ms ({})   {}  (JIT initialisation "
-        "before it: {:.2f} ms at most)\n",
-        worst_fresh, worst_fresh_shape, worst_fresh <= 50 ? "met" : "MISSED", fresh_init);
+    fmt::print("  first compile in a fresh process <= 50 ms (worst): {:>5.2f} ms ({})   {}  (the default "
+               "engine's, fast "
+               "machine code; JIT initialisation before it: {:.2f} ms at most)\n",
+               worst_fresh_fast, worst_fresh_fast_shape, worst_fresh_fast <= 50 ? "met" : "MISSED",
+               fresh_init);
+    fmt::print("    the same, optimised machine code (--engine jit): {:>5.2f} ms ({})\n", worst_fresh,
+               worst_fresh_shape);
     json += fmt::format(
         "  \"targets\": {{\"jit_vs_interp_carpet\": {:.3f}, \"jit_vs_handwritten_per_box\": {:.4f}, "
         "\"jit_scalar_vs_handwritten_per_box\": {:.4f}, \"worst_compile_ms\": {:.3f}, "
         "\"worst_compile_shape\": \"{}\", \"worst_fresh_compile_ms\": {:.3f}, \"worst_fresh_compile_shape\": "
-        "\"{}\", \"fresh_jit_init_ms\": {:.3f}}}\n}}\n",
+        "\"{}\", \"fresh_jit_init_ms\": {:.3f}, \"worst_fresh_fast_compile_ms\": {:.3f}, "
+        "\"worst_fresh_fast_compile_shape\": \"{}\"}}\n}}\n",
         speedup, vs_hand, t_j1 / t_hand, worst_compile, json_escape(worst_shape), worst_fresh,
-        json_escape(worst_fresh_shape), fresh_init);
+        json_escape(worst_fresh_shape), fresh_init, worst_fresh_fast, json_escape(worst_fresh_fast_shape));
     std::ofstream(json_path) << json;
     fmt::print("wrote {}\n", json_path);
     return 0;

@@ -65,12 +65,17 @@ public:
     }
 
     std::unique_ptr<llvm::orc::LLJIT> jit;
-    std::unique_ptr<llvm::TargetMachine> tm; // target information for the optimiser
-    std::mutex mu;                           // one compile (and one removal) at a time
+    std::unique_ptr<llvm::TargetMachine> tm;      // target information for the optimiser
+    std::unique_ptr<llvm::TargetMachine> tm_fast; // the same target, machine code unoptimised
+    std::mutex mu;                                // one compile (and one removal) at a time
     std::atomic<std::uint64_t> counter{0};
     bool avx512 = false; // the host has AVX-512F
     bool avx = false;    // ... AVX
     std::string target;  // what decides an object besides its IR (the cache key's part)
+    std::string target_fast;
+
+    llvm::TargetMachine& machine(const JitConfig& c) const { return c.fast_codegen ? *tm_fast : *tm; }
+    const std::string& target_of(const JitConfig& c) const { return c.fast_codegen ? target_fast : target; }
 
     int lanes_for(const JitConfig& c, Rounding r) const {
         int lanes = c.lanes;
@@ -110,8 +115,15 @@ private:
             error = "cannot create an LLVM target machine: " + to_string(tm.takeError());
             return nullptr;
         }
-        // Modules are compiled to objects by `tm` (compile() below, serialised by `mu`: one target
-        // machine for every compile) and linked from there, so that an object can come from the cache.
+        jtmb->setCodeGenOptLevel(llvm::CodeGenOptLevel::None);
+        auto tm_fast = jtmb->createTargetMachine();
+        if (!tm_fast) {
+            error = "cannot create an LLVM target machine: " + to_string(tm_fast.takeError());
+            return nullptr;
+        }
+        jtmb->setCodeGenOptLevel(llvm::CodeGenOptLevel::Default);
+        // Modules are compiled to objects by `tm` or `tm_fast` (compile() below, serialised by `mu`)
+        // and linked from there, so that an object can come from the cache.
         auto jit = llvm::orc::LLJITBuilder().setJITTargetMachineBuilder(*jtmb).create();
         if (!jit) {
             error = "cannot start the LLVM ORC JIT: " + to_string(jit.takeError());
@@ -133,8 +145,11 @@ private:
         }
         e->jit = std::move(*jit);
         e->tm = std::move(*tm);
-        e->target = e->tm->getTargetTriple().str() + " " + e->tm->getTargetCPU().str() + " " +
-                    e->tm->getTargetFeatureString().str() + " codegen-level-default";
+        e->tm_fast = std::move(*tm_fast);
+        const std::string host = e->tm->getTargetTriple().str() + " " + e->tm->getTargetCPU().str() + " " +
+                                 e->tm->getTargetFeatureString().str();
+        e->target = host + " codegen-level-default";
+        e->target_fast = host + " codegen-level-none";
         return e;
     }
 };
@@ -375,18 +390,19 @@ std::shared_ptr<const Compiled> compile(const ir::Tape& tape, const ir::EvalOpti
         std::string ir;
         llvm::raw_string_ostream os(ir);
         g.module->print(os, nullptr);
-        key = CodeCache::key(os.str(), engine->target);
+        key = CodeCache::key(os.str(), engine->target_of(config));
         object = cache->load(key);
         info.cache = object ? "hit" : "miss";
         info.cache_ms = ms_since(t);
     }
+    if (!object && config.cache_only) throw NotCached("jit: the code is not in the cache");
     if (!object) {
         t = Clock::now();
         optimize(*g.module, engine->tm.get());
         info.optimize_ms = ms_since(t);
         info.ir_instructions = instruction_count(*g.module);
         t = Clock::now();
-        auto compiled = llvm::orc::SimpleCompiler(*engine->tm)(*g.module);
+        auto compiled = llvm::orc::SimpleCompiler(engine->machine(config))(*g.module);
         if (!compiled) throw JitError("LLVM could not compile a shape: " + to_string(compiled.takeError()));
         object = std::move(*compiled);
         info.machine_ms = ms_since(t);

@@ -28,6 +28,12 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+// make_jit with JitConfig::cache_only found no object in the cache.
+class NotCached : public JitError {
+public:
+    using JitError::JitError;
+};
+
 // Whether the JIT works in this process (initialises LLVM once). On false, `why` says why, and the
 // caller falls back to the interpreter and tells the user so.
 bool jit_available(std::string* why = nullptr);
@@ -46,6 +52,13 @@ struct JitConfig {
     // that call external functions embed their addresses and are never cached.
     std::string cache_dir;
     std::size_t cache_max_bytes = std::size_t{256} << 20;
+    // LLVM's machine code generation without optimisation (CodeGenOptLevel::None; the IR passes are
+    // the same): compiles about 2x faster, runs up to 1.4x slower, the same results bit for bit. The
+    // tiered engine's first compile (docs/performance.md "First compile in a fresh process").
+    bool fast_codegen = false;
+    // Only from the on-disk cache: make_jit throws NotCached when the object is not there (the tiered
+    // engine's first try, so that a warm cache of optimised code is used at once).
+    bool cache_only = false;
 };
 
 // A configuration that chooses the form of the code only (no cache).

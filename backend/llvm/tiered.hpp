@@ -1,6 +1,9 @@
 // Tiered evaluation: the interpreter answers at once while LLVM compiles the tape on a background
 // thread; each evaluator (and each clone, per subdivision thread) moves to the machine code as soon
-// as it is ready. The default engine of the command line ("auto"), so that a small job never waits
+// as it is ready. That first compile uses LLVM's fast machine code generation (about half the time);
+// once the evaluations on it would repay the optimised code's compile (optimize_after), that is
+// compiled on the same thread and each evaluator moves to it at its next call (the two give the same
+// results bit for bit). The default engine of the command line ("auto"), so that a small job never waits
 // for the compiler and a large one gets the JIT's speed.
 //
 // Outputs must not depend on when the compile finishes. Where the JIT's enclosures are the
@@ -12,6 +15,8 @@
 #pragma once
 
 #include "backend/llvm/jit.hpp"
+
+#include <optional>
 
 namespace frac::jit {
 
@@ -38,6 +43,10 @@ std::unique_ptr<ir::Evaluator> make_tiered(const ir::Tape& tape, const ir::EvalO
 // JIT 2.1; LLVM about 15 ms plus 0.4 ms per unit).
 std::uint64_t checkpoint_evaluations(const ir::Tape& tape);
 
+// Evaluations on the first compile's code (LLVM's fast machine code generation) after which compiling
+// the optimised code would repay itself, from what the fast compile took (`fast`).
+std::uint64_t optimize_after(const ir::Tape& tape, const CompileInfo& fast);
+
 // When the last evaluator of a tape goes, its queued compile is dropped and one in progress is waited
 // for: LLVM's static objects must not be destroyed under it at exit. A program that promises to end
 // with std::_Exit (after flushing its output) while background_compile_pending() — the CLI, which must
@@ -50,5 +59,20 @@ bool background_compile_pending();
 // Blocks until the compile of a tiered evaluator (or a clone) has finished or failed, for tests and
 // benchmarks. No effect on other evaluators.
 void wait_for_tier(ir::Evaluator& e);
+
+// Blocks until the optimised compile of a tiered evaluator has finished, if it was asked for; returns
+// whether it was.
+bool wait_for_optimized_tier(ir::Evaluator& e);
+
+// Where a tiered evaluator stands (for tests, benchmarks and --verbose); nullopt for other evaluators.
+enum class Tier { interpreter, fast, optimized };
+struct TierStatus {
+    Tier tier = Tier::interpreter; // the code this evaluator runs
+    std::uint64_t evaluated = 0;   // evaluations on the fast code, every evaluator of the tape
+    std::uint64_t optimize_at = 0; // ... at which the optimised compile is asked for
+    bool optimize_asked = false;
+    bool optimized_ready = false;
+};
+std::optional<TierStatus> tier_status(const ir::Evaluator& e);
 
 } // namespace frac::jit

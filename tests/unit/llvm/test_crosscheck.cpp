@@ -30,6 +30,62 @@ TEST_CASE("every stdlib shape: JIT and interpreter agree bit for bit", "[llvm][c
     }
 }
 
+TEST_CASE("fast and optimised machine code agree bit for bit, inline kernels included",
+          "[llvm][crosscheck]") {
+    // The tiered engine moves from the first to the second whenever the second is ready: every tape,
+    // the ones with the loose inline kernels (sin, cos, exp, ...) too, must give the same bits.
+    using R = jit::JitConfig::Rounding;
+    std::vector<jit::JitConfig> configs = {jit::codegen_config(R::automatic, 0),
+                                           jit::codegen_config(R::constrained, 4)};
+    if (jit::host_has_avx512()) configs.push_back(jit::codegen_config(R::avx512, 1));
+    std::vector<std::pair<ir::Tape, std::vector<Interval>>> tapes;
+    std::set<std::string> seen;
+    for (const std::string& file : stdlib_files()) {
+        const Model m = compile("import \"" + file + "\";");
+        for (std::size_t i = 0; i < m.tapes.size(); ++i)
+            if (seen.insert(m.shape(i).name).second) tapes.emplace_back(m.tapes[i], m.shape(i).box);
+    }
+    for (const char* e : {"sin(x) * cos(3 * y) + tan(x - y)", "exp(x) - log(abs(y) + 1)", "atan2(y, x) + x^y",
+                          "pow(abs(x), 1/3) + sin(x * y)^2"}) {
+        const Model m = compile(std::string("shape s(x, y) = ") + e + ";");
+        tapes.emplace_back(m.tapes[0], default_range(2));
+    }
+    std::size_t compared = 0, loose = 0;
+    for (const jit::JitConfig& config : configs)
+        for (std::size_t t = 0; t < tapes.size(); ++t) {
+            const auto& [tape, range] = tapes[t];
+            INFO(describe(config) << ", tape " << t);
+            loose += has_loose_kernel(tape);
+            auto optimised = jit::make_jit(tape, {}, config);
+            auto fast = jit::make_jit(tape, {}, fast_codegen(config));
+            BoxMaker mk(31 + t);
+            const std::size_t n = 200;
+            std::vector<Interval> boxes;
+            std::vector<double> points;
+            for (std::size_t k = 0; k < n; ++k) {
+                const auto b = mk.box(range);
+                boxes.insert(boxes.end(), b.begin(), b.end());
+                const auto p = mk.point(range);
+                points.insert(points.end(), p.begin(), p.end());
+            }
+            std::vector<Interval> bo(n), bf(n);
+            optimised->eval_boxes(boxes.data(), n, bo.data());
+            fast->eval_boxes(boxes.data(), n, bf.data());
+            std::vector<double> po(n), pf(n);
+            optimised->eval_points(points.data(), n, po.data());
+            fast->eval_points(points.data(), n, pf.data());
+            for (std::size_t k = 0; k < n; ++k) {
+                INFO("box " << hex_box(&boxes[k * static_cast<std::size_t>(tape.inputs)], tape.inputs));
+                REQUIRE(same(bo[k], bf[k]));
+                REQUIRE(same(po[k], pf[k]));
+                ++compared;
+            }
+            CHECK(optimised->stats.series_terms == fast->stats.series_terms);
+        }
+    CHECK(loose >= configs.size() * 4); // the inline kernels were among them
+    CHECK(compared >= 200 * tapes.size() * configs.size());
+}
+
 TEST_CASE("series options: fixed term counts and small term limits agree", "[llvm][crosscheck]") {
     const Model m = compile("import \"fractals\"; import \"koch\";");
     for (int variant = 0; variant < 3; ++variant) {

@@ -5,8 +5,11 @@
 #include "runtime/rss.hpp"
 
 #include <chrono>
+#include <filesystem>
+#include <limits>
 #include <stdexcept>
 #include <thread>
+#include <unistd.h>
 
 using namespace frac;
 using namespace frac::test;
@@ -194,4 +197,99 @@ TEST_CASE("covers with checkpoints are the same on any threads and in every run"
     }
     // Past the threshold: the switch happened inside these covers.
     CHECK(covers.front().evaluated > 2 * jit::checkpoint_evaluations(tape));
+}
+
+TEST_CASE("a tiered evaluator moves from the fast code to the optimised one once that repays",
+          "[llvm][tiered]") {
+    // An exact tape (moves at any call) and one with inline kernels (moves at checkpoints): the fast
+    // code first, then the optimised code once the evaluations reach optimize_at, the same bits
+    // throughout.
+    for (const char* source :
+         {scene, "shape s(x, y) over [-3, 3] × [-3, 3] = sin(2 * x) * cos(y) - 0.2 * y;"}) {
+        const Model m = compile(source);
+        const ir::Tape& tape = only_tape(m);
+        const bool exact = jit::tiers_exactly(tape);
+        INFO(source);
+        auto tiered = jit::make_tiered(tape, {}, {},
+                                       exact ? jit::TierSwitch::when_ready : jit::TierSwitch::checkpoints);
+        auto reference = jit::make_jit(tape); // optimised code: the same bits as the fast code
+        REQUIRE(jit::tier_status(*tiered));
+        CHECK_FALSE(jit::tier_status(*reference));
+        jit::wait_for_tier(*tiered);
+        if (!exact) tiered->checkpoint(jit::checkpoint_evaluations(tape));
+        BoxMaker r(11);
+        const std::size_t n = 4096;
+        std::vector<Interval> boxes, got(n), want(n);
+        for (std::size_t k = 0; k < n; ++k) {
+            const auto b = r.box({{-1, 1}, {-1, 1}});
+            boxes.insert(boxes.end(), b.begin(), b.end());
+        }
+        reference->eval_boxes(boxes.data(), n, want.data());
+        tiered->eval_boxes(boxes.data(), n, got.data());
+        jit::TierStatus st = *jit::tier_status(*tiered);
+        CHECK(st.tier == jit::Tier::fast);
+        CHECK(st.evaluated == n);
+        CHECK(st.optimize_at >= 1);
+        CHECK(st.optimize_at < std::numeric_limits<std::uint64_t>::max()); // set by the fast compile
+        // Until the threshold, no optimised compile; at it, one is asked for.
+        while (st.evaluated + n < st.optimize_at) {
+            tiered->eval_boxes(boxes.data(), n, got.data());
+            st = *jit::tier_status(*tiered);
+            REQUIRE_FALSE(st.optimize_asked);
+        }
+        while (!st.optimize_asked) {
+            tiered->eval_boxes(boxes.data(), n, got.data());
+            st = *jit::tier_status(*tiered);
+        }
+        for (std::size_t k = 0; k < n; ++k) REQUIRE(same(got[k], want[k]));
+        REQUIRE(jit::wait_for_optimized_tier(*tiered));
+        CHECK(jit::tier_status(*tiered)->optimized_ready);
+        tiered->eval_boxes(boxes.data(), n, got.data());
+        CHECK(jit::tier_status(*tiered)->tier == jit::Tier::optimized);
+        for (std::size_t k = 0; k < n; ++k) REQUIRE(same(got[k], want[k]));
+        // A clone made now starts on the optimised code at its first call.
+        auto clone = tiered->clone();
+        clone->eval_boxes(boxes.data(), n, got.data());
+        CHECK(jit::tier_status(*clone)->tier == jit::Tier::optimized);
+        for (std::size_t k = 0; k < n; ++k) REQUIRE(same(got[k], want[k]));
+    }
+}
+
+TEST_CASE("with a warm code cache the tiered engine starts on the optimised code", "[llvm][tiered]") {
+    const Model m = compile(scene);
+    const ir::Tape& tape = only_tape(m);
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("frac-test-tiered-cache-" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir);
+    jit::JitConfig config;
+    config.cache_dir = (dir / "cache").string();
+    const std::vector<Interval> box{{-0.5, 0.25}, {0.1, 0.2}};
+    {
+        // A cold cache: the fast code first, stored under its own key.
+        auto tiered = jit::make_tiered(tape, {}, config);
+        jit::wait_for_tier(*tiered);
+        tiered->eval_box(box.data());
+        CHECK(jit::tier_status(*tiered)->tier == jit::Tier::fast);
+    }
+    // The optimised code, stored by a plain JIT: now the tiered engine takes it from the cache at once
+    // and never compiles.
+    const Interval want = jit::make_jit(tape, {}, config)->eval_box(box.data());
+    const auto dir_of_cache = dir / "cache";
+    const auto stored = std::distance(std::filesystem::directory_iterator(dir_of_cache),
+                                      std::filesystem::directory_iterator());
+    CHECK(stored == 2); // the fast code's and the optimised code's
+    auto tiered = jit::make_tiered(tape, {}, config);
+    jit::wait_for_tier(*tiered);
+    CHECK(same(tiered->eval_box(box.data()), want));
+    const jit::TierStatus st = *jit::tier_status(*tiered);
+    CHECK(st.tier == jit::Tier::optimized);
+    CHECK(st.optimize_at == std::numeric_limits<std::uint64_t>::max());
+    CHECK(std::distance(std::filesystem::directory_iterator(dir_of_cache),
+                        std::filesystem::directory_iterator()) == stored);
+    // Only from the cache: a tape not in it is not compiled.
+    jit::JitConfig only = config;
+    only.cache_only = true;
+    CHECK_THROWS_AS(jit::make_jit(only_tape(compile("shape s(x, y) = x * y - 0.125;")), {}, only),
+                    jit::NotCached);
+    std::filesystem::remove_all(dir);
 }
