@@ -19,16 +19,17 @@ using ir::TapeSeries;
 Facts facts_of(const Interval* v, std::size_t n) {
     Facts f;
     f.maybe_empty = false;
-    f.lo_positive = f.hi_negative = f.lo_nonzero = f.hi_nonzero = true;
+    f.lo_positive = f.hi_negative = f.lo_nonzero = f.hi_nonzero = f.thin = true;
     for (std::size_t k = 0; k < n; ++k) {
         const Interval& x = v[k];
         if (x.is_empty()) f.maybe_empty = true;
+        if (!(x.lo == x.hi)) f.thin = false;
         if (!(x.lo > 0)) f.lo_positive = false;
         if (!(x.hi < 0)) f.hi_negative = false;
         if (x.lo == 0) f.lo_nonzero = false;
         if (x.hi == 0) f.hi_nonzero = false;
     }
-    if (f.maybe_empty) f.lo_positive = f.hi_negative = false;
+    if (f.maybe_empty) f.lo_positive = f.hi_negative = f.thin = false;
     return f;
 }
 

@@ -32,6 +32,7 @@ struct Facts {
     bool hi_negative = false; // hi < 0
     bool lo_nonzero = false;  // lo != 0 (also for NaN-free values only)
     bool hi_nonzero = false;
+    bool thin = false; // lo == hi in every value (none empty)
 };
 Facts facts_of(const Interval* values, std::size_t n);
 
