@@ -156,12 +156,13 @@ public:
     using CostOf = std::function<double(const Tape&)>;
     // `fallback` (optional) makes the second tier's evaluator of a tape, whose results are the
     // engine's bit for bit; `fallback_eval_ns` gives its time per evaluation of a tape in a cover
-    // (the interpreter's depends on the tape: flat or not), and `fallback_ns_fixed` the least of it
-    // (an empty tape's); without them the fallback is never used.
+    // (the interpreter's depends on the tape: flat or not; the least of it is an empty tape's);
+    // without them the fallback is never used.
     SpecializationCache(Compile compile, PruneCosts costs, Compile fallback = {},
-                        CostOf fallback_eval_ns = {}, double fallback_ns_fixed = 0)
+                        CostOf fallback_eval_ns = {})
         : compile_(std::move(compile)), fallback_(std::move(fallback)), costs_(costs),
-          fallback_eval_ns_(std::move(fallback_eval_ns)), fallback_ns_fixed_(fallback_ns_fixed) {}
+          fallback_eval_ns_(std::move(fallback_eval_ns)),
+          fallback_ns_fixed_(fallback_eval_ns_ ? fallback_eval_ns_(Tape{}) : 0) {}
 
     // Whether recording the choices over a box of a tape of cost `cost_current`, which costs
     // `record_ns` (in the unit of eval_ns_per_cost), can pay at all for a cell with
@@ -188,8 +189,8 @@ private:
     Compile compile_, fallback_;
     PruneCosts costs_;
     CostOf fallback_eval_ns_;
-    double fallback_ns_fixed_;
-    mutable std::mutex mu_; // held while compiling, so no tape is compiled twice
+    double fallback_ns_fixed_; // fallback_eval_ns_ of an empty tape
+    mutable std::mutex mu_;    // held while compiling, so no tape is compiled twice
     std::map<std::string, Entry> entries_;
     std::size_t compiled_count_ = 0;
 };

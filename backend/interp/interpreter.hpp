@@ -30,8 +30,8 @@ double eval_ns_per_cost(const ir::Tape& tape);
 
 // What an evaluation of a pruned tape costs the interpreter in a cover apart from the tape's
 // instructions (in the unit of the constants above): the call on a parent's few children at a time,
-// the cell's box, its verdict and the pushes below it (bench/bench_prune part 2 measures it from
-// pruned covers; docs/performance.md "The second tier's fixed cost").
+// the cell's box, its verdict and the pushes below it (bench/bench_prune part 1b measures it from
+// pruned covers; docs/performance.md "The JIT's pruning on short tapes").
 inline constexpr double cover_eval_ns_fixed = 260.0;
 // Time per evaluation of `tape` in a pruned cover: the fixed part and the tape's.
 double cover_eval_ns(const ir::Tape& tape);

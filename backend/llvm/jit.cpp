@@ -449,7 +449,7 @@ std::unique_ptr<ir::Evaluator> make_jit(const ir::Tape& tape, const ir::EvalOpti
         // Until a pruned tape has earned its compile time, the interpreter runs it when that is faster
         // than the JIT running the whole tape; its enclosures are the JIT's bit for bit.
         [options](const ir::Tape& t) { return interp::make_interpreter(t, options); },
-        [](const ir::Tape& t) { return interp::cover_eval_ns(t); }, interp::cover_eval_ns_fixed);
+        [](const ir::Tape& t) { return interp::cover_eval_ns(t); });
     *self = cache;
     root->own_cache(std::move(cache));
     return root;

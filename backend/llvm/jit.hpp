@@ -81,7 +81,7 @@ std::unique_ptr<ir::Evaluator> make_jit(const ir::Tape& tape, const ir::EvalOpti
 // What specialising costs and saves with the JIT (ir/specialize.hpp), measured by bench/bench_prune:
 // evaluation time per unit of tape cost and box, compile time of a pruned tape.
 // Its fixed part per evaluation in a cover (the generated code builds and classifies the cells) is
-// measured by bench/bench_prune part 2 like the interpreter's cover_eval_ns_fixed.
+// measured by bench/bench_prune part 1b like the interpreter's cover_eval_ns_fixed.
 inline constexpr ir::PruneCosts jit_prune_costs{.eval_ns_per_cost = 0.8,
                                                 .compile_ns_fixed = 2.0e7,
                                                 .compile_ns_per_instruction = 2.0e6,

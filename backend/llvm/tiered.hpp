@@ -64,7 +64,7 @@ void wait_for_tier(ir::Evaluator& e);
 // whether it was.
 bool wait_for_optimized_tier(ir::Evaluator& e);
 
-// Where a tiered evaluator stands (for tests, benchmarks and --verbose); nullopt for other evaluators.
+// Where a tiered evaluator stands (for tests and benchmarks); nullopt for other evaluators.
 enum class Tier { interpreter, fast, optimized };
 struct TierStatus {
     Tier tier = Tier::interpreter; // the code this evaluator runs

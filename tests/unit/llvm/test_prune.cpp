@@ -224,10 +224,10 @@ shape balls(x, y, z) over [-2, 2] × [-2, 2] × [-2, 2] =
     CHECK(compiled->engine() == "jit");
     CHECK(compiled->instruction_count() < tape.instruction_count());
     // The rule itself: a long tape is worth recording for the fallback, a short one is not.
-    ir::SpecializationCache cache(
-        [](const ir::Tape&) -> std::unique_ptr<ir::Evaluator> { return nullptr; }, jit::jit_prune_costs,
-        [](const ir::Tape& t) { return interp::make_interpreter(t); },
-        [](const ir::Tape& t) { return interp::cover_eval_ns(t); }, interp::cover_eval_ns_fixed);
+    ir::SpecializationCache cache([](const ir::Tape&) -> std::unique_ptr<ir::Evaluator> { return nullptr; },
+                                  jit::jit_prune_costs,
+                                  [](const ir::Tape& t) { return interp::make_interpreter(t); },
+                                  [](const ir::Tape& t) { return interp::cover_eval_ns(t); });
     const auto record = [](double c) { return interp::tape_eval_ns_per_cost * c; };
     CHECK_FALSE(cache.may_pay(cost, few, record(cost)));
     CHECK(cache.may_pay(cost, 1e12, record(cost)));
