@@ -142,38 +142,44 @@ private:
     // ---- floating point, rounded upward ----
     static constexpr int ru_sae = 2 | 8; // _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC
     static constexpr int rd_sae = 1 | 8; // _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC
-    Value* x86_round(llvm::Intrinsic::ID scalar, llvm::Intrinsic::ID packed, Value* x, Value* y) {
+    Value* x86_round(llvm::Intrinsic::ID scalar, llvm::Intrinsic::ID packed, Value* x, Value* y,
+                     int rounding = ru_sae) {
+        const auto mode = static_cast<std::uint32_t>(rounding);
         if (w_ == 8) {
             Function* f = llvm::Intrinsic::getDeclaration(&m_, packed);
-            return b_.CreateCall(f, {x, y, b_.getInt32(ru_sae)});
+            return b_.CreateCall(f, {x, y, b_.getInt32(mode)});
         }
         auto* v2 = llvm::FixedVectorType::get(dbl_, 2);
         Value* zero = llvm::ConstantAggregateZero::get(v2);
         Value* a = b_.CreateInsertElement(zero, x, b_.getInt64(0));
         Value* c = b_.CreateInsertElement(zero, y, b_.getInt64(0));
         Function* f = llvm::Intrinsic::getDeclaration(&m_, scalar);
-        Value* r = b_.CreateCall(f, {a, c, zero, b_.getInt8(0xff), b_.getInt32(ru_sae)});
+        Value* r = b_.CreateCall(f, {a, c, zero, b_.getInt8(0xff), b_.getInt32(mode)});
         return b_.CreateExtractElement(r, b_.getInt64(0));
     }
-    Value* add(Value* x, Value* y) {
+    // The AVX-512 instruction of an operation with embedded rounding (ru_sae / rd_sae).
+    enum class Arith { add, sub, mul, div };
+    Value* x86_arith(Arith op, Value* x, Value* y, int rounding) {
         using namespace llvm::Intrinsic;
-        return avx512_ ? x86_round(x86_avx512_mask_add_sd_round, x86_avx512_add_pd_512, x, y)
-                       : b_.CreateFAdd(x, y);
+        static constexpr llvm::Intrinsic::ID scalar[] = {
+            x86_avx512_mask_add_sd_round, x86_avx512_mask_sub_sd_round, x86_avx512_mask_mul_sd_round,
+            x86_avx512_mask_div_sd_round};
+        static constexpr llvm::Intrinsic::ID packed[] = {x86_avx512_add_pd_512, x86_avx512_sub_pd_512,
+                                                         x86_avx512_mul_pd_512, x86_avx512_div_pd_512};
+        const auto k = static_cast<std::size_t>(op);
+        return x86_round(scalar[k], packed[k], x, y, rounding);
+    }
+    Value* add(Value* x, Value* y) {
+        return avx512_ ? x86_arith(Arith::add, x, y, ru_sae) : b_.CreateFAdd(x, y);
     }
     Value* sub(Value* x, Value* y) {
-        using namespace llvm::Intrinsic;
-        return avx512_ ? x86_round(x86_avx512_mask_sub_sd_round, x86_avx512_sub_pd_512, x, y)
-                       : b_.CreateFSub(x, y);
+        return avx512_ ? x86_arith(Arith::sub, x, y, ru_sae) : b_.CreateFSub(x, y);
     }
     Value* mul(Value* x, Value* y) {
-        using namespace llvm::Intrinsic;
-        return avx512_ ? x86_round(x86_avx512_mask_mul_sd_round, x86_avx512_mul_pd_512, x, y)
-                       : b_.CreateFMul(x, y);
+        return avx512_ ? x86_arith(Arith::mul, x, y, ru_sae) : b_.CreateFMul(x, y);
     }
     Value* div(Value* x, Value* y) {
-        using namespace llvm::Intrinsic;
-        return avx512_ ? x86_round(x86_avx512_mask_div_sd_round, x86_avx512_div_pd_512, x, y)
-                       : b_.CreateFDiv(x, y);
+        return avx512_ ? x86_arith(Arith::div, x, y, ru_sae) : b_.CreateFDiv(x, y);
     }
     // x * y + z with one rounding (upward).
     Value* fma(Value* x, Value* y, Value* z) {
@@ -216,10 +222,21 @@ private:
                                 vt_);
     }
     Value* neg(Value* x) { return b_.CreateFNeg(x); }
-    Value* add_down(Value* x, Value* y) { return neg(sub(neg(x), y)); }
-    Value* sub_down(Value* x, Value* y) { return neg(add(neg(x), y)); }
-    Value* mul_down(Value* x, Value* y) { return neg(mul(neg(x), y)); }
-    Value* div_down(Value* x, Value* y) { return neg(div(neg(x), y)); }
+    // Lower bounds: RD(x op y) = -RU(-x op' y), signed zeros included (IEEE's rules for exact zeros are
+    // symmetric). AVX-512 rounds down in the instruction; elsewhere two negations around the upward
+    // operation.
+    Value* add_down(Value* x, Value* y) {
+        return avx512_ ? x86_arith(Arith::add, x, y, rd_sae) : neg(sub(neg(x), y));
+    }
+    Value* sub_down(Value* x, Value* y) {
+        return avx512_ ? x86_arith(Arith::sub, x, y, rd_sae) : neg(add(neg(x), y));
+    }
+    Value* mul_down(Value* x, Value* y) {
+        return avx512_ ? x86_arith(Arith::mul, x, y, rd_sae) : neg(mul(neg(x), y));
+    }
+    Value* div_down(Value* x, Value* y) {
+        return avx512_ ? x86_arith(Arith::div, x, y, rd_sae) : neg(div(neg(x), y));
+    }
     Value* rounding_intrinsic(llvm::Intrinsic::ID plain, llvm::Intrinsic::ID constrained, Value* x) {
         if (avx512_) return b_.CreateUnaryIntrinsic(plain, x);
         return b_.CreateConstrainedFPCall(llvm::Intrinsic::getDeclaration(&m_, constrained, {vt_}), {x});
@@ -285,6 +302,7 @@ private:
     IV widen_nan(Value* lo, Value* hi) {
         return {sel(isnan(lo), cst(-inf), lo), sel(isnan(hi), cst(inf), hi)};
     }
+    IV widen_nan_unless(bool cannot_be_nan, Value* lo, Value* hi);
     Value* is_zero(const SlotState& s, bool upper) {
         if (s.known) return i1((upper ? s.k.hi : s.k.lo) == 0);
         if (upper ? s.f.hi_nonzero : s.f.lo_nonzero) return i1(false);

@@ -7,33 +7,46 @@
 namespace frac::jit::box {
 
 // ---- interval operations: numeric/interval.cpp, step by step ----
+// A finite operand rules out inf - inf, the only NaN of a sum of non-empty intervals.
+IV BoxGen::widen_nan_unless(bool cannot_be_nan, Value* lo, Value* hi) {
+    return cannot_be_nan ? IV{lo, hi} : widen_nan(lo, hi);
+}
+
 SlotState BoxGen::op_add(const SlotState& a, const SlotState& b) {
     Value* e = lor(empty_of(a), empty_of(b));
-    return result(guard(e, widen_nan(add_down(a.v.lo, b.v.lo), add(a.v.hi, b.v.hi)), empty()),
-                  a.f.maybe_empty || b.f.maybe_empty);
+    return result(
+        guard(e, widen_nan_unless(a.f.finite || b.f.finite, add_down(a.v.lo, b.v.lo), add(a.v.hi, b.v.hi)),
+              empty()),
+        a.f.maybe_empty || b.f.maybe_empty);
 }
 
 SlotState BoxGen::op_sub(const SlotState& a, const SlotState& b) {
     Value* e = lor(empty_of(a), empty_of(b));
-    return result(guard(e, widen_nan(sub_down(a.v.lo, b.v.hi), sub(a.v.hi, b.v.lo)), empty()),
-                  a.f.maybe_empty || b.f.maybe_empty);
+    return result(
+        guard(e, widen_nan_unless(a.f.finite || b.f.finite, sub_down(a.v.lo, b.v.hi), sub(a.v.hi, b.v.lo)),
+              empty()),
+        a.f.maybe_empty || b.f.maybe_empty);
 }
 
 SlotState BoxGen::op_mul(const SlotState& a, const SlotState& b) {
     Value* e = lor(empty_of(a), empty_of(b));
-    // A factor thin and positive in every lane (a constant, a table of 3^i): interval.cpp's thin path,
-    // with the factor it takes (b when b is thin, else a). Its lower bound is RD(y.lo x) (the one at
-    // y.hi is never strictly smaller), so three products instead of the corners' eight.
-    const SlotState* thin = b.f.thin                      ? (b.f.lo_positive ? &b : nullptr)
-                            : a.f.thin && a.f.lo_positive ? &a
-                                                          : nullptr;
-    if (thin) {
-        const SlotState& y = thin == &b ? a : b;
-        Value* x = thin->v.lo;
+    // A factor positive in every lane (a constant, a table of 3^i, thin or not): each bound of the
+    // product is one corner, the lower one at y.lo and the upper one at y.hi, with the factor's end
+    // chosen by that bound's sign. The corners' minimum never ties at a signed zero; their maximum is
+    // 0 only when y.hi <= 0, and then interval.cpp keeps the first zero corner, the one at (y.lo, p.lo)
+    // when it is zero: so that corner is computed too and wins ties. Three products instead of eight,
+    // bit for bit the corners' result (a thin factor is interval.cpp's thin path).
+    const SlotState* pos = b.f.lo_positive ? &b : a.f.lo_positive ? &a : nullptr;
+    if (pos) {
+        const SlotState& y = pos == &b ? a : b;
+        const bool thin = pos->f.thin;
+        Value* p_lo = pos->v.lo;
+        Value* p_hi = thin ? p_lo : pos->v.hi;
         Value* zl = is_zero(y, false);
-        Value* lo = sel(zl, cst(0.0), mul_down(y.v.lo, x));
-        Value* up_lo = sel(zl, cst(0.0), mul(y.v.lo, x));
-        Value* up_hi = sel(is_zero(y, true), cst(0.0), mul(y.v.hi, x));
+        Value* lo = sel(zl, cst(0.0), mul_down(y.v.lo, thin ? p_lo : sel(ge(y.v.lo, cst(0.0)), p_lo, p_hi)));
+        Value* up_lo = sel(zl, cst(0.0), mul(y.v.lo, p_lo));
+        Value* up_hi =
+            sel(is_zero(y, true), cst(0.0), mul(y.v.hi, thin ? p_lo : sel(ge(y.v.hi, cst(0.0)), p_hi, p_lo)));
         Value* hi = sel(lt(up_lo, up_hi), up_hi, up_lo);
         return result(guard(e, {lo, hi}, empty()), a.f.maybe_empty || b.f.maybe_empty);
     }
@@ -74,7 +87,8 @@ IV BoxGen::div_nonzero(const SlotState& a, const SlotState& b, Value* pos) {
     Value* hi_num = sel(pos, a.v.hi, a.v.lo);
     Value* hi_den =
         sel(pos, sel(alo_nonneg, b.v.lo, sel(ahi_nonpos, b.v.hi, b.v.lo)), sel(alo_nonneg, b.v.lo, b.v.hi));
-    return widen_nan(div_down(lo_num, lo_den), div(hi_num, hi_den));
+    // A finite divisor not containing 0: no 0 / 0 or inf / inf.
+    return widen_nan_unless(b.f.finite, div_down(lo_num, lo_den), div(hi_num, hi_den));
 }
 
 SlotState BoxGen::op_div(const SlotState& a, const SlotState& b) {

@@ -19,17 +19,18 @@ using ir::TapeSeries;
 Facts facts_of(const Interval* v, std::size_t n) {
     Facts f;
     f.maybe_empty = false;
-    f.lo_positive = f.hi_negative = f.lo_nonzero = f.hi_nonzero = f.thin = true;
+    f.lo_positive = f.hi_negative = f.lo_nonzero = f.hi_nonzero = f.thin = f.finite = true;
     for (std::size_t k = 0; k < n; ++k) {
         const Interval& x = v[k];
         if (x.is_empty()) f.maybe_empty = true;
+        if (!(std::isfinite(x.lo) && std::isfinite(x.hi))) f.finite = false;
         if (!(x.lo == x.hi)) f.thin = false;
         if (!(x.lo > 0)) f.lo_positive = false;
         if (!(x.hi < 0)) f.hi_negative = false;
         if (x.lo == 0) f.lo_nonzero = false;
         if (x.hi == 0) f.hi_nonzero = false;
     }
-    if (f.maybe_empty) f.lo_positive = f.hi_negative = f.thin = false;
+    if (f.maybe_empty) f.lo_positive = f.hi_negative = f.thin = f.finite = false;
     return f;
 }
 
@@ -94,6 +95,61 @@ void series_tables(const Tape& t, const TapeSeries& s, const ir::EvalOptions& o,
     }
 }
 
+// Which slots hold finite intervals wherever they are written: a greatest fixed point (every written
+// slot starts finite and loses it at any write that does not prove it), an inductive invariant over
+// the evaluation order. Inputs (boxes may be unbounded), series results, states and indices: not
+// finite; constants and index tables: their exact facts. Provably finite: dz and mod1 of a non-empty
+// interval (within [0, 1]), floor, ceil, neg and abs of a finite one, min and max of two.
+void finite_facts(const Tape& t, Tables& out) {
+    std::vector<Facts>& f = out.slot_facts;
+    std::vector<bool> fixed(t.num_slots, false); // facts set outright: constants, index tables
+    for (const ir::TapeConst& c : t.constants) fixed[c.slot] = true;
+    for (const IndexTable& tab : out.index_tables) fixed[tab.slot] = true;
+    std::vector<bool> written(t.num_slots, false);
+    std::function<void(std::uint32_t)> mark = [&](std::uint32_t block) {
+        for (const Instr& ins : t.blocks[block]) {
+            if (ir::is_series(ins.op)) mark(t.series[ins.series].block);
+            if (!fixed[ins.out]) written[ins.out] = true;
+        }
+    };
+    mark(0);
+    for (Slot s = 0; s < t.num_slots; ++s)
+        if (!fixed[s]) f[s].finite = written[s];
+    for (const TapeSeries& s : t.series) {
+        for (Slot c : s.state_slots) f[c].finite = false;
+        f[s.index_slot].finite = false;
+    }
+    bool changed = true;
+    auto proves = [&](const Instr& ins) {
+        auto in = [&](int k) { return f[ins.in[static_cast<std::size_t>(k)]]; };
+        switch (ins.op) {
+        case Op::Dz:
+        case Op::Mod1: return !in(0).maybe_empty;
+        case Op::Floor:
+        case Op::Ceil:
+        case Op::Neg:
+        case Op::Abs: return in(0).finite;
+        case Op::Min:
+        case Op::Max: return in(0).finite && in(1).finite;
+        default: return false;
+        }
+    };
+    std::function<void(std::uint32_t)> walk = [&](std::uint32_t block) {
+        for (const Instr& ins : t.blocks[block]) {
+            if (ir::is_series(ins.op)) walk(t.series[ins.series].block);
+            if (fixed[ins.out] || !f[ins.out].finite) continue;
+            if (ir::is_series(ins.op) || !proves(ins)) {
+                f[ins.out].finite = false;
+                changed = true;
+            }
+        }
+    };
+    while (changed) {
+        changed = false;
+        walk(0);
+    }
+}
+
 // Fixed point of maybe_empty over the tape (orbit states feed back, so one pass is not enough).
 void analyse(const Tape& t, Tables& out) {
     std::vector<Facts>& f = out.slot_facts;
@@ -127,6 +183,7 @@ void analyse(const Tape& t, Tables& out) {
         changed = false;
         walk(0);
     }
+    finite_facts(t, out);
 }
 
 } // namespace

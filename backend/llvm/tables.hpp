@@ -33,6 +33,9 @@ struct Facts {
     bool lo_nonzero = false;  // lo != 0 (also for NaN-free values only)
     bool hi_nonzero = false;
     bool thin = false; // lo == hi in every value (none empty)
+    // Both ends finite in every lane (so none empty): a sum with such an operand, or a quotient by
+    // such a divisor of known sign, is never NaN (no inf - inf, 0 / 0 or inf / inf).
+    bool finite = false;
 };
 Facts facts_of(const Interval* values, std::size_t n);
 
