@@ -189,9 +189,10 @@ SlotState BoxGen::op_dz(const SlotState& a) {
     Value* fh = floor(hi);
     Value* ch = ceil(hi);
     // dz_down(x) = min(sub_down(x, floor x), sub_down(ceil x, x)); dz_up(x) = min(x - floor x, ceil x -
-    // x)
-    Value* rlo =
-        std_min(std_min(sub_down(lo, fl), sub_down(cl, lo)), std_min(sub_down(hi, fh), sub_down(ch, hi)));
+    // x). The lower bound min(dz_down(lo), dz_down(hi)) counts only when no integer lies in [lo, hi]:
+    // then floor hi = floor lo, ceil lo = ceil hi, and of the four differences, all positive, the
+    // least is at lo - floor lo or ceil hi - hi (RD is monotone; equal positive doubles have equal bits).
+    Value* rlo = std_min(sub_down(lo, fl), sub_down(ch, hi));
     Value* rhi = std_max(std_min(sub(lo, fl), sub(cl, lo)), std_min(sub(hi, fh), sub(ch, hi)));
     rlo = sel(le(cl, hi), cst(0.0), rlo);
     Value* half = add(fl, cst(0.5));
