@@ -159,6 +159,10 @@ public:
     // False when specialize() returns null whatever it is asked (nothing to prune, pruning off, an
     // engine that does not specialise): callers skip asking per cell.
     virtual bool may_specialize() const { return false; }
+    // False when specialize(box, expected_evaluations) returns null for every box as things stand (a
+    // rule that depends only on the tape and the expected evaluations, or an engine not ready to
+    // prune): a cover asks once per level and then skips its cells' requests.
+    virtual bool may_specialize_now(double expected_evaluations) { return may_specialize(); }
     // Whether specialize() depends only on this evaluator's function and the box, not on a state
     // shared with its clones (a cache filled in the order of requests): then a cover asks on every
     // thread at once, and the answers do not depend on which thread asked first.

@@ -82,6 +82,7 @@ struct Variant {
     std::vector<ir::Evaluator*> workers; // one per thread
     double instructions = 0;             // of its function
     bool may_specialize = false;         // its function can be pruned further
+    bool ask_this_level = false;         // ... and its evaluator may prune for this level's cells
     bool prune_in_chunks = false;        // ... by each thread's evaluator as it evaluates
 };
 
@@ -298,6 +299,10 @@ private:
         // whatever the threads.
         for (const Variant& v : variants_)
             for (ir::Evaluator* w : v.workers) w->checkpoint(r_.evaluated);
+        // Whether to ask for pruned functions cell by cell this level: not where no cell's request could
+        // be granted (a virtual call, a cell box and a rounding-mode switch per undecided cell).
+        for (Variant& v : variants_)
+            v.ask_this_level = v.may_specialize && v.workers[0]->may_specialize_now(expected_descendants_);
         level_variants_.clear();
         prune_in_chunks_ = false;
         for (const Variant& v : variants_) {
@@ -488,7 +493,7 @@ private:
                 const Variant& v = variants_[p.variant];
                 if (v.prune_in_chunks)
                     next_.back().variant = adopt(p.variant, std::move(b.pruned[j]));
-                else if (v.may_specialize)
+                else if (v.ask_this_level)
                     next_.back().variant = pruned_variant(p);
             }
         }
@@ -681,6 +686,7 @@ private:
             nv.instructions = static_cast<double>(pruned->instruction_count());
             nv.may_specialize = pruned->may_specialize();
             nv.prune_in_chunks = nv.may_specialize && pruned->specializes_independently();
+            nv.ask_this_level = nv.may_specialize && pruned->may_specialize_now(expected_descendants_);
             // An evaluator made for this cell alone (no cache holds it) serves the first thread itself.
             const bool own = pruned.use_count() == 1;
             for (int t = 0; t < threads_; ++t) {

@@ -234,7 +234,23 @@ public:
     bool may_specialize() const override {
         return code_->options.prune && code_->has_choices && !cache_.expired();
     }
+    bool may_specialize_now(double expected_evaluations) override {
+        return static_cast<bool>(may_record(expected_evaluations));
+    }
     std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
+        const auto cache = may_record(expected_evaluations);
+        if (!cache) return nullptr;
+        const auto t0 = Clock::now();
+        if (!recorder_) recorder_ = std::make_unique<interp::ChoiceRecorder>(code_->tape, code_->options);
+        const std::vector<ir::Choice> choices = recorder_->record(box);
+        specialize_stats.record_ms += ms_since(t0);
+        ++specialize_stats.requests;
+        return cache->get(code_->tape, choices, expected_evaluations, specialize_stats);
+    }
+
+    // The cache when a recording for this many evaluations could pay (SpecializationCache::may_pay),
+    // else null.
+    std::shared_ptr<ir::SpecializationCache> may_record(double expected_evaluations) {
         if (!code_->options.prune || !code_->has_choices ||
             expected_evaluations < jit_min_expected_evaluations)
             return nullptr;
@@ -244,12 +260,7 @@ public:
         // A recording is an evaluation by the tape interpreter.
         if (!cache->may_pay(cost_, expected_evaluations, interp::tape_eval_ns_per_cost * cost_))
             return nullptr;
-        const auto t0 = Clock::now();
-        if (!recorder_) recorder_ = std::make_unique<interp::ChoiceRecorder>(code_->tape, code_->options);
-        const std::vector<ir::Choice> choices = recorder_->record(box);
-        specialize_stats.record_ms += ms_since(t0);
-        ++specialize_stats.requests;
-        return cache->get(code_->tape, choices, expected_evaluations, specialize_stats);
+        return cache;
     }
 
     void own_cache(std::shared_ptr<ir::SpecializationCache> cache) {

@@ -364,10 +364,13 @@ public:
 
     // Until the code is ready a pruned tape would be an interpreted one for the cell's whole subtree,
     // which would never move to the JIT: prune nothing, the children ask again.
+    bool may_specialize_now(double expected_evaluations) override {
+        ir::Evaluator& e = current();
+        return !waiting_for_code(e) && e.may_specialize_now(expected_evaluations);
+    }
     std::shared_ptr<ir::Evaluator> specialize(const Interval* box, double expected_evaluations) override {
         ir::Evaluator& e = current();
-        if (&e == interp_.get() && owner_->state->phase.load(std::memory_order_acquire) != Phase::failed)
-            return nullptr;
+        if (waiting_for_code(e)) return nullptr;
         e.specialize_stats = {};
         auto p = e.specialize(box, expected_evaluations);
         specialize_stats += e.specialize_stats;
@@ -412,6 +415,9 @@ public:
     }
 
 private:
+    bool waiting_for_code(const ir::Evaluator& e) const {
+        return &e == interp_.get() && owner_->state->phase.load(std::memory_order_acquire) != Phase::failed;
+    }
     // The first compile's code (phase ready).
     void take_first_code() {
         jit_ = owner_->state->jit->clone();

@@ -217,6 +217,26 @@ shape balls(x, y, z) over [-2, 2] × [-2, 2] × [-2, 2] =
     REQUIRE(few * jit::jit_prune_costs.eval_ns_per_cost * cost < jit::jit_prune_costs.compile_ns_fixed);
     CHECK_FALSE(jt->specialize(box.data(), few));
     CHECK(jt->specialize_stats.requests == 0); // not even recorded
+    // ... which the evaluator says for a whole level of such cells, so a cover does not ask them one by
+    // one; the interpreter's cover does.
+    CHECK_FALSE(jt->may_specialize_now(few));
+    CHECK(jt->may_specialize_now(1e12));
+    CHECK(in->may_specialize_now(few));
+    {
+        rt::RssOptions o;
+        o.depth = 7;
+        const std::vector<Interval> root(3, Interval(-2, 2));
+        auto jc = JitEngine::make(tape);
+        auto ic = InterpEngine::make(tape);
+        const rt::RssResult jr = rt::subdivide(*jc, root, o);
+        const rt::RssResult ir_ = rt::subdivide(*ic, root, o);
+        CHECK(rt::same_cover(jr, ir_));
+        std::uint64_t jit_asked = 0, interp_asked = 0;
+        for (const rt::PruneLevel& l : jr.prune_levels) jit_asked += l.requests;
+        for (const rt::PruneLevel& l : ir_.prune_levels) interp_asked += l.requests;
+        CHECK(jit_asked == 0);
+        CHECK(interp_asked > 0);
+    }
     // A cell whose descendants alone would repay compiling: asked, recorded, compiled.
     auto compiled = jt->specialize(box.data(), 1e12);
     CHECK(jt->specialize_stats.requests == 1);
