@@ -247,6 +247,11 @@ private:
     Value* ceil(Value* x) {
         return rounding_intrinsic(llvm::Intrinsic::ceil, llvm::Intrinsic::experimental_constrained_ceil, x);
     }
+    // The nearest integer, ties to even (exact in every mode).
+    Value* round_even(Value* x) {
+        return rounding_intrinsic(llvm::Intrinsic::roundeven,
+                                  llvm::Intrinsic::experimental_constrained_roundeven, x);
+    }
     Value* fabs(Value* x) { return b_.CreateUnaryIntrinsic(llvm::Intrinsic::fabs, x); }
     // double(i) rounded upward, as the interpreter converts indices (exact below 2^53).
     Value* index_to_double(Value* i, bool exact) {

@@ -186,14 +186,18 @@ SlotState BoxGen::op_dz(const SlotState& a) {
     Value* whole = lnot(lt(sub(hi, lo), cst(1.0))); // !(hi - lo < 1): a whole period
     Value* fl = floor(lo);
     Value* cl = ceil(lo);
-    Value* fh = floor(hi);
     Value* ch = ceil(hi);
     // dz_down(x) = min(sub_down(x, floor x), sub_down(ceil x, x)); dz_up(x) = min(x - floor x, ceil x -
     // x). The lower bound min(dz_down(lo), dz_down(hi)) counts only when no integer lies in [lo, hi]:
     // then floor hi = floor lo, ceil lo = ceil hi, and of the four differences, all positive, the
     // least is at lo - floor lo or ceil hi - hi (RD is monotone; equal positive doubles have equal bits).
     Value* rlo = std_min(sub_down(lo, fl), sub_down(ch, hi));
-    Value* rhi = std_max(std_min(sub(lo, fl), sub(cl, lo)), std_min(sub(hi, fh), sub(ch, hi)));
+    // The upper bound max(dz_up(lo), dz_up(hi)) counts only when no half-integer lies in [lo, hi]: then
+    // both ends are nearer to one integer k than to any other (neither is a half-integer), dz_up(x) is
+    // RU(|x - k|) (the nearer difference; RU is monotone), and the larger of the two is RU(k - lo) or
+    // RU(hi - k), whichever is not negative (both +0 when lo = hi = k, as dz_up gives).
+    Value* k = round_even(lo);
+    Value* rhi = std_max(sub(k, lo), sub(hi, k));
     rlo = sel(le(cl, hi), cst(0.0), rlo);
     Value* half = add(fl, cst(0.5));
     half = sel(lt(half, lo), add(half, cst(1.0)), half);
