@@ -234,6 +234,8 @@ public:
             // The two frontiers swap buffers: no level regrows (and faults in) a fresh one.
             parents_.swap(next_);
             next_.clear();
+            parent_rows_.swap(next_rows_);
+            next_rows_.clear();
             release_unused(parents_);
             start_level(k);
             // Room for the level's undecided cells at once (growing by doubling would copy and
@@ -340,22 +342,27 @@ private:
 
     // The order of the level's cells: the children of the previous level's undecided cells (row-major)
     // in row-major order. The children of one parent row fill `split` child rows, each running over all
-    // the parents of the row; likewise for slabs of constant iz in 3D. Linear in the rows.
+    // the parents of the row; likewise for slabs of constant iz in 3D. Linear in the rows (parent_rows_,
+    // found as the parents were taken): a scan of the parents themselves, serial between two levels,
+    // took 7-9 ms of a 0.25 s two-thread carpet cover at depth 12.
     void plan_children() {
         blocks_.clear();
         const std::uint64_t s = static_cast<std::uint64_t>(r_.split);
         const std::uint32_t sz = d_ == 3 ? static_cast<std::uint32_t>(s) : 1;
+        const std::size_t rows = parent_rows_.size();
+        const auto row_end = [&](std::size_t row) {
+            return row + 1 < rows ? parent_rows_[row + 1] : parents_.size();
+        };
         std::uint64_t first = 0;
-        for (std::size_t slab = 0; slab < parents_.size();) {
-            std::size_t slab_end = slab;
-            while (slab_end < parents_.size() && parents_[slab_end].iz == parents_[slab].iz) ++slab_end;
+        for (std::size_t slab = 0; slab < rows;) {
+            const std::uint32_t iz = parents_[parent_rows_[slab]].iz;
+            std::size_t slab_end = slab + 1;
+            while (slab_end < rows && parents_[parent_rows_[slab_end]].iz == iz) ++slab_end;
             for (std::uint32_t cz = 0; cz < sz; ++cz)
-                for (std::size_t row = slab; row < slab_end;) {
-                    std::size_t row_end = row;
-                    while (row_end < slab_end && parents_[row_end].iy == parents_[row].iy) ++row_end;
-                    blocks_.push_back({row, row_end - row, cz, first});
-                    first += (row_end - row) * s * s;
-                    row = row_end;
+                for (std::size_t row = slab; row < slab_end; ++row) {
+                    const std::size_t begin = parent_rows_[row], count = row_end(row) - begin;
+                    blocks_.push_back({begin, count, cz, first});
+                    first += count * s * s;
                 }
             slab = slab_end;
         }
@@ -488,6 +495,8 @@ private:
             for (std::size_t u = c.begin; u < c.begin + c.undecided; ++u) {
                 const std::uint32_t j = b.undecided[u];
                 const Pos& p = b.cells[j];
+                if (next_.empty() || next_.back().iy != p.iy || next_.back().iz != p.iz)
+                    next_rows_.push_back(next_.size()); // a row starts (plan_children)
                 next_.push_back(p);
                 if (!consider_pruning_) continue;
                 const Variant& v = variants_[p.variant];
@@ -767,11 +776,12 @@ private:
     std::uint64_t level_cells_ = 0;  // ... and their number
     std::size_t min_cells_per_chunk_ = min_chunk;
     std::vector<LevelVariant> level_variants_;
-    bool prune_in_chunks_ = false;    // some of the level's cells prune in the chunks
-    bool consider_pruning_ = false;   // the level's undecided cells ask for pruned functions
-    double expected_descendants_ = 0; // ... for this many evaluations below each
-    std::vector<Pos> next_;           // undecided cells of level_, row-major
-    std::vector<Pos> parents_;        // ... of the level before
+    bool prune_in_chunks_ = false;                     // some of the level's cells prune in the chunks
+    bool consider_pruning_ = false;                    // the level's undecided cells ask for pruned functions
+    double expected_descendants_ = 0;                  // ... for this many evaluations below each
+    std::vector<Pos> next_;                            // undecided cells of level_, row-major
+    std::vector<Pos> parents_;                         // ... of the level before
+    std::vector<std::size_t> next_rows_, parent_rows_; // where each row (iy, iz) of each starts
     Clock::time_point last_progress_;
 };
 
