@@ -417,11 +417,18 @@ private:
             return;
         }
         if (n < b->min_args || n > b->max_args) {
-            const std::string want = b->min_args == b->max_args ? fmt::format("{}", b->min_args)
-                                     : b->max_args >= 64        ? fmt::format("at least {}", b->min_args)
-                                                         : fmt::format("{} to {}", b->min_args, b->max_args);
-            d_.error(e.loc, fmt::format("'{}' takes {} argument{}, {} given", e.text, want,
-                                        b->max_args == 1 ? "" : "s", n));
+            // A variadic builtin's bound that was passed: "at least" below it, "at most" above it (with
+            // the way around it), else the range.
+            const bool variadic = b->max_args >= 64;
+            const std::string want = b->min_args == b->max_args    ? fmt::format("{}", b->min_args)
+                                     : variadic && n < b->min_args ? fmt::format("at least {}", b->min_args)
+                                     : variadic                    ? fmt::format("at most {}", b->max_args)
+                                                : fmt::format("{} to {}", b->min_args, b->max_args);
+            d_.error(e.loc, fmt::format("'{}' takes {} argument{}, {} given{}", e.text, want,
+                                        b->max_args == 1 ? "" : "s", n,
+                                        variadic && n > b->max_args
+                                            ? fmt::format(" (nest the calls: {0}({0}(...), ...))", e.text)
+                                            : ""));
         }
         if (b->kind != BuiltinKind::dimension)
             for (const Arg& a : e.args)
