@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <iostream>
 #include <map>
+#include <oneapi/tbb/global_control.h>
 #include <optional>
 #include <pthread.h>
 
@@ -51,6 +52,9 @@ int finish(int status) {
 
 int main(int argc, char** argv) {
     frac::driver::leave_compiles_at_exit(); // finish() below
+    // Worker threads get a large stack too, whatever parallel work starts them first
+    // (rt::worker_stack_bytes).
+    tbb::global_control worker_stack(tbb::global_control::thread_stack_size, frac::rt::worker_stack_bytes);
     Work work{argc, argv};
     pthread_attr_t attr;
     pthread_t thread;

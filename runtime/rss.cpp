@@ -1,6 +1,7 @@
 #include "runtime/rss.hpp"
 
 #include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
 #include <oneapi/tbb/task_group.h>
@@ -760,6 +761,7 @@ private:
     static constexpr double min_chunk_instructions = 256 * 64; // ... when they evaluate 64 instructions each
     static constexpr std::uint64_t grid_table_limit = 1 << 16; // cells per axis with a table of grid points
     static constexpr std::size_t chunks_per_thread = 8;        // dynamic balance between threads
+    tbb::global_control worker_stack_{tbb::global_control::thread_stack_size, worker_stack_bytes};
     ir::Evaluator& f_;
     RssResult& r_;
     int d_;

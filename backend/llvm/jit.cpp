@@ -381,6 +381,7 @@ std::shared_ptr<const Compiled> compile(const ir::Tape& tape, const ir::EvalOpti
     CompileInfo& info = code->info;
     info.rounding = rounding == Rounding::avx512 ? "avx512" : "constrained";
     info.lanes = lanes;
+    info.fast_codegen = config.fast_codegen;
 
     auto t = Clock::now();
     const Tables tables = build_tables(tape, options);

@@ -103,8 +103,9 @@ struct CompileInfo {
     double total_ms = 0;             // make_jit from start to finish
     std::size_t ir_instructions = 0; // after optimisation (0 when the object came from the cache)
     std::size_t table_bytes = 0;
-    std::string rounding; // "avx512" or "constrained"
-    int lanes = 1;        // boxes per vector of the interval code
+    std::string rounding;      // "avx512" or "constrained"
+    int lanes = 1;             // boxes per vector of the interval code
+    bool fast_codegen = false; // LLVM's fast machine code generation (JitConfig::fast_codegen)
     // The on-disk cache: "off" (none, or the tape calls external functions), "miss" (compiled, then
     // stored) or "hit" (loaded: no optimisation, no code generation).
     std::string cache = "off";

@@ -10,6 +10,8 @@
 #include "ir/specialize.hpp"
 #include "runtime/rss.hpp"
 
+#include <cmath>
+#include <fmt/format.h>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -499,4 +501,58 @@ TEST_CASE("the default engine interprets a large model with choices, and compile
     const Model small = compile(csg_model);
     const front::ShapeInfo& scene = info_of(small, "scene");
     CHECK(driver::make_evaluator(small.c->module, scene.root, scene.dimension, options)->engine() == "jit");
+}
+
+namespace {
+
+// A sum of `terms` square roots of distances to distinct points (no min/max to prune), written as groups of
+// 100 terms so that the parser's recursion stays shallow.
+std::string long_sum(int terms) {
+    std::string sum;
+    for (int g = 0; g * 100 < terms; ++g) {
+        std::string group;
+        for (int i = g * 100; i < std::min(terms, (g + 1) * 100); ++i)
+            group += fmt::format("{}sqrt((x - {:.6f})^2 + (y - {:.6f})^2 + 0.01)", group.empty() ? "" : " + ",
+                                 std::fmod(i * 0.6180339887, 1.0), std::fmod(i * 0.7548776662, 1.0));
+        sum += (sum.empty() ? "(" : " + (") + group + ")";
+    }
+    return fmt::format("shape s(x, y) over [-1, 1] × [-1, 1] = ({}) / {} - 0.75;\n", sum, terms);
+}
+
+} // namespace
+
+TEST_CASE("a tape past 10,000 instructions: the default engine interprets it, the JIT compiles it with "
+          "fast machine code, and past 40,000 both interpret",
+          "[llvm][prune]") {
+    const Model m = compile(long_sum(1500));
+    const front::ShapeInfo& s = info_of(m, "s");
+    const std::size_t n = tape_of(m, "s").instruction_count();
+    INFO(n << " instructions");
+    REQUIRE(n > 10000);
+    REQUIRE(n < 40000);
+    driver::EngineOptions options;
+    options.engine = "auto";
+    CHECK(driver::make_evaluator(m.c->module, s.root, s.dimension, options)->engine() == "interp");
+    options.engine = "jit";
+    const auto jitted = driver::make_evaluator(m.c->module, s.root, s.dimension, options);
+    REQUIRE(jitted->engine() == "jit");
+    REQUIRE(jit::compile_info(*jitted) != nullptr);
+    CHECK(jit::compile_info(*jitted)->fast_codegen);
+    // The same enclosures as the interpreter, bit for bit.
+    options.engine = "interp";
+    const auto interpreted = driver::make_evaluator(m.c->module, s.root, s.dimension, options);
+    const std::vector<ir::Interval> boxes = {{0.1, 0.2}, {0.3, 0.4}, {-1, 1},
+                                             {-1, 1},    {0.5, 0.5}, {0.25, 0.75}};
+    std::vector<ir::Interval> a(3), b(3);
+    jitted->eval_boxes(boxes.data(), 3, a.data());
+    interpreted->eval_boxes(boxes.data(), 3, b.data());
+    for (std::size_t i = 0; i < 3; ++i) {
+        CHECK(a[i].lo == b[i].lo);
+        CHECK(a[i].hi == b[i].hi);
+    }
+    const Model huge = compile(long_sum(6000));
+    const front::ShapeInfo& hs = info_of(huge, "s");
+    REQUIRE(tape_of(huge, "s").instruction_count() > 40000);
+    options.engine = "jit";
+    CHECK(driver::make_evaluator(huge.c->module, hs.root, hs.dimension, options)->engine() == "interp");
 }
