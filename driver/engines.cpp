@@ -23,14 +23,14 @@ namespace {
 // far below it.
 constexpr std::size_t jit_max_prunable_instructions = 1000;
 
-// The default engine interprets any tape longer than this, and the JIT, asked for by name, compiles it
-// with LLVM's fast machine code generation (JitConfig::fast_codegen). The optimised machine code
-// generation grows about quadratically with the length of one function (its machine scheduler; a sum
-// of n square roots: 4.1 s at 10,000 instructions, 18.8 s at 20,000), the fast one linearly (1.0 s and
-// 2.4 s), and its code still evaluates a box about 3 times faster than the interpreter. But a compile
-// of seconds beside a cover on two cores made the default engine slower than the interpreter (a
-// depth-15 picture of 12,400 instructions: 3.15 s against 2.28), so it waits for a measured rule of
-// when a job is long enough (docs/performance.md, "Long tapes").
+// A tape longer than this gets LLVM's fast machine code generation only (JitConfig::fast_codegen): the
+// optimised one grows about quadratically with the length of one function (its machine scheduler; a
+// sum of n square roots: 4.1 s at 10,000 instructions, 18.8 s at 20,000), the fast one linearly (1.0 s
+// and 2.4 s), and its code still evaluates a box about 3 times faster than the interpreter. The default
+// engine interprets it until the interpreted work has taken about what the compile will take
+// (jit::long_tape_start_after), then compiles in the background: a compile of seconds started at once
+// beside a cover on two cores made it slower than the interpreter (a depth-15 picture of 12,400
+// instructions: 3.15 s against 2.28; docs/performance.md, "Long tapes").
 constexpr std::size_t jit_max_optimized_instructions = 10000;
 
 // Any tape longer than this is interpreted, whatever the engine asked for: the fast machine code
@@ -57,21 +57,28 @@ std::unique_ptr<ir::Evaluator> make_evaluator(const front::Module& m, ir::NodeId
                                     tape.instruction_count() > jit_max_prunable_instructions;
     const bool automatic = options.engine == "auto";
     const bool wants_jit = options.engine == "jit" || automatic;
-    const std::size_t most = automatic ? jit_max_optimized_instructions : jit_max_instructions;
-    const bool too_long = tape.instruction_count() > most;
+    const bool long_tape = tape.instruction_count() > jit_max_optimized_instructions;
+    // Long tapes compile late (long_tape_start_after), which needs the switch at any call.
+    const bool too_long = tape.instruction_count() > jit_max_instructions ||
+                          (automatic && long_tape && !jit::tiers_exactly(tape));
     if (wants_jit && too_long && !prunable_and_large) {
         static bool told = false; // say it once per run
         if (!told)
             std::cerr << fmt::format(
-                "frac: note: {} instructions are more than the {} compiles in reasonable "
+                "frac: note: {} instructions are more than the JIT compiles in reasonable "
                 "time ({}); using the interpreter\n",
-                tape.instruction_count(), automatic ? "default engine" : "JIT", most);
+                tape.instruction_count(),
+                tape.instruction_count() > jit_max_instructions ? jit_max_instructions
+                                                                : jit_max_optimized_instructions);
         told = true;
     } else if (wants_jit && !prunable_and_large) {
         jit::JitConfig config;
         config.cache_dir = options.jit_cache_dir;
-        config.fast_codegen = tape.instruction_count() > jit_max_optimized_instructions;
+        config.fast_codegen = long_tape;
         // The interpreter serves while LLVM starts and compiles, where that cannot change a result.
+        if (automatic && long_tape)
+            return jit::make_tiered(tape, options.eval, config, jit::TierSwitch::when_ready,
+                                    jit::long_tape_start_after(tape));
         if (automatic && jit::tiers_exactly(tape)) return jit::make_tiered(tape, options.eval, config);
         if (automatic && options.checkpoints)
             return jit::make_tiered(tape, options.eval, config, jit::TierSwitch::checkpoints);

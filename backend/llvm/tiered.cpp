@@ -4,6 +4,7 @@
 
 #include <pthread.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -126,7 +127,11 @@ enum class Phase { queued, compiling, ready, failed };
 struct TierState {
     ir::Tape tape;
     ir::EvalOptions options;
-    JitConfig config; // the optimised code's; the first compile's has fast_codegen
+    JitConfig config; // the optimised code's (unless fast_codegen); the first compile's has fast_codegen
+    // The first compile starts once the interpreter has made this many evaluations (0: at once).
+    std::uint64_t start_after = 0;
+    std::atomic<std::uint64_t> interpreted{0};
+    std::atomic<bool> started{false}; // the first compile is queued (or done)
     std::atomic<Phase> phase{Phase::queued};
     std::unique_ptr<ir::Evaluator> jit; // written before phase becomes ready, then only read
     std::string error;                  // written before phase becomes failed
@@ -208,7 +213,9 @@ public:
             }
             if (!s.jit) {
                 s.jit = make_jit(s.tape, s.options, first_config);
-                s.first_is_optimized = !first_config.fast_codegen;
+                // A configuration asking for the fast machine code has no second compile (long tapes:
+                // LLVM's optimised machine code generation grows quadratically with their length).
+                s.first_is_optimized = !first_config.fast_codegen || s.config.fast_codegen;
             }
             if (!s.first_is_optimized)
                 s.optimize_at.store(optimize_after(s.tape, *compile_info(*s.jit)), std::memory_order_relaxed);
@@ -308,6 +315,12 @@ private:
     pthread_t thread_{};
 };
 
+// Queues the first compile of `s` (once); without a compile thread, compiles the optimised code now.
+void start_first_compile(const std::shared_ptr<TierState>& s) {
+    if (s->started.exchange(true, std::memory_order_acq_rel)) return;
+    if (!Compiler::get().enqueue(s)) Compiler::compile(*s, s->config);
+}
+
 // Shared by a tiered evaluator and its clones; the last one to go tells the compiler.
 struct TierOwner {
     std::shared_ptr<TierState> state;
@@ -403,10 +416,12 @@ public:
         t.optimize_at = s.optimize_at.load(std::memory_order_relaxed);
         t.optimize_asked = s.optimize_asked.load(std::memory_order_relaxed);
         t.optimized_ready = s.optimized_ready.load(std::memory_order_acquire);
+        t.compile_started = s.started.load(std::memory_order_acquire);
         return t;
     }
 
     void wait() {
+        start_first_compile(owner_->state); // a delayed compile is due now
         std::unique_lock<std::mutex> lock(owner_->state->done_mu);
         owner_->state->done.wait(lock, [&] {
             const Phase p = owner_->state->phase.load(std::memory_order_acquire);
@@ -456,7 +471,17 @@ private:
         auto r = f(e);
         stats += e.stats;
         if (jit_ && !optimized_) count_towards_optimizing(e.stats.calls);
+        if (!jit_) count_towards_starting(e.stats.calls);
         return r;
+    }
+
+    // The interpreted evaluations of every evaluator of the tape; past the state's start_after the
+    // first compile is queued (once).
+    void count_towards_starting(std::uint64_t calls) {
+        TierState& s = *owner_->state;
+        if (s.started.load(std::memory_order_relaxed)) return;
+        if (s.interpreted.fetch_add(calls, std::memory_order_relaxed) + calls >= s.start_after)
+            start_first_compile(owner_->state);
     }
 
     // The evaluations on the fast code, of every evaluator of the tape; past the state's
@@ -502,8 +527,17 @@ std::uint64_t optimize_after(const ir::Tape& tape, const CompileInfo& fast) {
     return static_cast<std::uint64_t>(std::max(1.0, compile_ns / (saved_ns_per_cost * cost)));
 }
 
+std::uint64_t long_tape_start_after(const ir::Tape& tape) {
+    // Measured (docs/performance.md, "Long tapes"): the fast machine code of a long tape compiles in
+    // 0.10-0.15 ms per instruction (0.98 s at 9,971, 5.8 s at 38,000 with the rest of the compile).
+    constexpr double compile_ns_per_instruction = 0.15e6;
+    const double compile_ns = compile_ns_per_instruction * static_cast<double>(tape.instruction_count());
+    return static_cast<std::uint64_t>(std::max(1.0, compile_ns / interp::cover_eval_ns(tape)));
+}
+
 std::unique_ptr<ir::Evaluator> make_tiered(const ir::Tape& tape, const ir::EvalOptions& options,
-                                           const JitConfig& config, TierSwitch when) {
+                                           const JitConfig& config, TierSwitch when,
+                                           std::uint64_t start_after) {
     if (when == TierSwitch::when_ready && !tiers_exactly(tape))
         throw std::invalid_argument(
             "make_tiered: the tape has an inline kernel wider than the interpreter's");
@@ -511,8 +545,9 @@ std::unique_ptr<ir::Evaluator> make_tiered(const ir::Tape& tape, const ir::EvalO
     state->tape = tape;
     state->options = options;
     state->config = config;
+    state->start_after = start_after;
     auto interp = interp::make_interpreter(tape, options);
-    if (!Compiler::get().enqueue(state)) Compiler::compile(*state, config); // no thread: optimised, now
+    if (start_after == 0) start_first_compile(state);
     return std::make_unique<TieredEvaluator>(
         std::make_shared<TierOwner>(std::move(state)), std::move(interp), nullptr,
         when == TierSwitch::when_ready ? 0 : checkpoint_evaluations(tape));

@@ -35,8 +35,17 @@ enum class TierSwitch {
 // evaluators are all gone is dropped). Until the switch, specialize() prunes nothing (the children
 // of a cell ask again). When compiling fails, the evaluator stays interpreted and says so once on
 // stderr. TierSwitch::when_ready requires tiers_exactly(tape) (std::invalid_argument otherwise).
+// A `config` with fast_codegen makes the fast code the last tier (no optimised compile follows).
+// `start_after` > 0 delays the compile until the interpreter has made that many evaluations (summed
+// over the evaluator and its clones; wait_for_tier starts it at once): a short job never compiles.
 std::unique_ptr<ir::Evaluator> make_tiered(const ir::Tape& tape, const ir::EvalOptions& options,
-                                           const JitConfig& config, TierSwitch when = TierSwitch::when_ready);
+                                           const JitConfig& config, TierSwitch when = TierSwitch::when_ready,
+                                           std::uint64_t start_after = 0);
+
+// The interpreted evaluations after which a long tape's fast compile starts: as many as take the
+// interpreter about the time the compile will take (the rent-or-buy rule: a job pays at most about
+// twice what it would with hindsight, and one shorter than the compile never compiles).
+std::uint64_t long_tape_start_after(const ir::Tape& tape);
 
 // Cells evaluated after which interpreting has cost about what compiling saves (measured rates on a
 // transcendental tape, bench_kernels' gyroid: the interpreter 24 ns per unit of tape cost and box, the
@@ -72,6 +81,7 @@ struct TierStatus {
     std::uint64_t optimize_at = 0; // ... at which the optimised compile is asked for
     bool optimize_asked = false;
     bool optimized_ready = false;
+    bool compile_started = false; // the first compile is queued or done
 };
 std::optional<TierStatus> tier_status(const ir::Evaluator& e);
 

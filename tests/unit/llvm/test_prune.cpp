@@ -521,38 +521,72 @@ std::string long_sum(int terms) {
 
 } // namespace
 
-TEST_CASE("a tape past 10,000 instructions: the default engine interprets it, the JIT compiles it with "
-          "fast machine code, and past 40,000 both interpret",
+TEST_CASE("a tape past 10,000 instructions: the JIT compiles it with fast machine code, the default engine "
+          "only once the interpreted work foretells a long job, and past 40,000 both interpret",
           "[llvm][prune]") {
     const Model m = compile(long_sum(1500));
     const front::ShapeInfo& s = info_of(m, "s");
-    const std::size_t n = tape_of(m, "s").instruction_count();
+    const ir::Tape& tape = tape_of(m, "s");
+    const std::size_t n = tape.instruction_count();
     INFO(n << " instructions");
     REQUIRE(n > 10000);
     REQUIRE(n < 40000);
     driver::EngineOptions options;
-    options.engine = "auto";
-    CHECK(driver::make_evaluator(m.c->module, s.root, s.dimension, options)->engine() == "interp");
+    options.engine = "interp";
+    const auto interpreted = driver::make_evaluator(m.c->module, s.root, s.dimension, options);
+    const std::vector<ir::Interval> boxes = {{0.1, 0.2}, {0.3, 0.4}, {-1, 1},
+                                             {-1, 1},    {0.5, 0.5}, {0.25, 0.75}};
+    std::vector<ir::Interval> want(3), got(3);
+    interpreted->eval_boxes(boxes.data(), 3, want.data());
+    const auto same = [&](ir::Evaluator& e) {
+        e.eval_boxes(boxes.data(), 3, got.data());
+        for (std::size_t i = 0; i < 3; ++i) {
+            CHECK(got[i].lo == want[i].lo);
+            CHECK(got[i].hi == want[i].hi);
+        }
+    };
+
+    // Asked for by name: compiled at once, the fast machine code, the interpreter's bits.
     options.engine = "jit";
     const auto jitted = driver::make_evaluator(m.c->module, s.root, s.dimension, options);
     REQUIRE(jitted->engine() == "jit");
     REQUIRE(jit::compile_info(*jitted) != nullptr);
     CHECK(jit::compile_info(*jitted)->fast_codegen);
-    // The same enclosures as the interpreter, bit for bit.
-    options.engine = "interp";
-    const auto interpreted = driver::make_evaluator(m.c->module, s.root, s.dimension, options);
-    const std::vector<ir::Interval> boxes = {{0.1, 0.2}, {0.3, 0.4}, {-1, 1},
-                                             {-1, 1},    {0.5, 0.5}, {0.25, 0.75}};
-    std::vector<ir::Interval> a(3), b(3);
-    jitted->eval_boxes(boxes.data(), 3, a.data());
-    interpreted->eval_boxes(boxes.data(), 3, b.data());
-    for (std::size_t i = 0; i < 3; ++i) {
-        CHECK(a[i].lo == b[i].lo);
-        CHECK(a[i].hi == b[i].hi);
-    }
+    same(*jitted);
+
+    // The default engine: interpreted, no compile started, for as many evaluations as take the
+    // interpreter about the compile's time.
+    const std::uint64_t start_after = jit::long_tape_start_after(tape);
+    CHECK(start_after ==
+          static_cast<std::uint64_t>(0.15e6 * static_cast<double>(n) / interp::cover_eval_ns(tape)));
+    CHECK(start_after > 1000);
+    options.engine = "auto";
+    const auto automatic = driver::make_evaluator(m.c->module, s.root, s.dimension, options);
+    REQUIRE(automatic->engine() == "auto");
+    same(*automatic);
+    CHECK(jit::tier_status(*automatic)->tier == jit::Tier::interpreter);
+    CHECK_FALSE(jit::tier_status(*automatic)->compile_started);
+
+    // The same rule with a short delay: the compile starts once the evaluator and its clone have made
+    // that many evaluations between them, and its fast code is the last tier.
+    jit::JitConfig fast;
+    fast.fast_codegen = true;
+    const auto tiered = jit::make_tiered(tape, {}, fast, jit::TierSwitch::when_ready, 5);
+    const auto clone = tiered->clone();
+    same(*tiered); // 3
+    CHECK_FALSE(jit::tier_status(*tiered)->compile_started);
+    same(*clone); // 6
+    CHECK(jit::tier_status(*tiered)->compile_started);
+    jit::wait_for_tier(*tiered);
+    same(*tiered);
+    CHECK(jit::tier_status(*tiered)->tier == jit::Tier::optimized); // the fast code, with nothing after it
+    CHECK_FALSE(jit::wait_for_optimized_tier(*tiered));
+
     const Model huge = compile(long_sum(6000));
     const front::ShapeInfo& hs = info_of(huge, "s");
     REQUIRE(tape_of(huge, "s").instruction_count() > 40000);
-    options.engine = "jit";
-    CHECK(driver::make_evaluator(huge.c->module, hs.root, hs.dimension, options)->engine() == "interp");
+    for (const char* engine : {"jit", "auto"}) {
+        options.engine = engine;
+        CHECK(driver::make_evaluator(huge.c->module, hs.root, hs.dimension, options)->engine() == "interp");
+    }
 }
