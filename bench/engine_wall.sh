@@ -4,7 +4,7 @@
 # small and large jobs, with the JIT's code cache off (every run compiles) and warm. Runs are
 # interleaved (auto, jit, interp, auto, ...) and the median of RUNS is printed with the ratios to the
 # interpreter: the default engine must never be slower than the interpreter alone (issue 13).
-# Usage: bench/engine_wall.sh FRAC [RUNS]
+# Usage: bench/engine_wall.sh FRAC [RUNS]   (ONLY=REGEX runs the jobs whose names match)
 set -u
 frac=$(realpath "$1") runs=${2:-5} here=$(cd "$(dirname "$0")/.." && pwd)
 work=$(mktemp -d)
@@ -21,11 +21,22 @@ jobs=(
     "menger d5|examples/menger_frame.frac --depth 5"
     "terrain d5|examples/rough_terrain.frac --depth 5"
     "gyroid d7|bench/kernel_scenes.frac gyroid_sphere --depth 7 --slice z=0.1"
+    "sum3000 d15|$work/long_sum.frac --depth 15"
+    "sum3000 d17|$work/long_sum.frac --depth 17"
 )
+# A long tape (12,373 instructions: the mean of 3,000 distances, nothing to prune): the default engine
+# compiles it only once the interpreted work has taken about what the compile will (driver/engines.cpp).
+awk 'BEGIN {
+    printf "shape s(x, y) over [-1, 1] * [-1, 1] = (";
+    for (i = 0; i < 3000; ++i)
+        printf "%ssqrt((x - %.4f)^2 + (y - %.4f)^2 + 0.01)", i ? " + " : "", (i % 97) / 97, (i % 89) / 89;
+    printf ") / 3000 - 0.75;\n";
+}' > "$work/long_sum.frac"
 printf '%-12s %-5s %9s %9s %9s %10s %10s\n' job cache auto_s jit_s interp_s auto/interp jit/interp
 for cache in off warm; do
     for job in "${jobs[@]}"; do
         name=${job%%|*} args=${job#*|}
+        [[ "$name" =~ ${ONLY:-.} ]] || continue
         declare -A t=([auto]="" [jit]="" [interp]="")
         if [ "$cache" = off ]; then export FRAC_CACHE_DIR=off; else export FRAC_CACHE_DIR="$work/cache"; fi
         # The warm cache is filled by one run first (the other engines do not use it).

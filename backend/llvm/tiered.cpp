@@ -128,10 +128,10 @@ struct TierState {
     ir::Tape tape;
     ir::EvalOptions options;
     JitConfig config; // the optimised code's (unless fast_codegen); the first compile's has fast_codegen
-    // The first compile starts once the interpreter has made this many evaluations (0: at once).
-    std::uint64_t start_after = 0;
-    std::atomic<std::uint64_t> interpreted{0};
-    std::atomic<bool> started{false}; // the first compile is queued (or done)
+    // The first compile starts once the interpreter has worked this long (0: at once).
+    std::chrono::nanoseconds start_after{0};
+    std::atomic<std::int64_t> interpreted_ns{0}; // every evaluator's, summed
+    std::atomic<bool> started{false};            // the first compile is queued (or done)
     std::atomic<Phase> phase{Phase::queued};
     std::unique_ptr<ir::Evaluator> jit; // written before phase becomes ready, then only read
     std::string error;                  // written before phase becomes failed
@@ -467,20 +467,23 @@ private:
     template <class F>
     std::invoke_result_t<F, ir::Evaluator&> counted(F&& f) {
         ir::Evaluator& e = current();
+        // A delayed compile counts the interpreter's time (two clock reads a call: a call is a batch).
+        const bool timed = &e == interp_.get() && !owner_->state->started.load(std::memory_order_relaxed);
+        const auto t0 = timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
         e.stats = {};
         auto r = f(e);
         stats += e.stats;
         if (jit_ && !optimized_) count_towards_optimizing(e.stats.calls);
-        if (!jit_) count_towards_starting(e.stats.calls);
+        if (timed) count_towards_starting(std::chrono::steady_clock::now() - t0);
         return r;
     }
 
-    // The interpreted evaluations of every evaluator of the tape; past the state's start_after the
-    // first compile is queued (once).
-    void count_towards_starting(std::uint64_t calls) {
+    // The interpreter's time, every evaluator's of the tape; past the state's start_after the first
+    // compile is queued (once).
+    void count_towards_starting(std::chrono::nanoseconds spent) {
         TierState& s = *owner_->state;
-        if (s.started.load(std::memory_order_relaxed)) return;
-        if (s.interpreted.fetch_add(calls, std::memory_order_relaxed) + calls >= s.start_after)
+        if (s.interpreted_ns.fetch_add(spent.count(), std::memory_order_relaxed) + spent.count() >=
+            s.start_after.count())
             start_first_compile(owner_->state);
     }
 
@@ -527,17 +530,21 @@ std::uint64_t optimize_after(const ir::Tape& tape, const CompileInfo& fast) {
     return static_cast<std::uint64_t>(std::max(1.0, compile_ns / (saved_ns_per_cost * cost)));
 }
 
-std::uint64_t long_tape_start_after(const ir::Tape& tape) {
+std::chrono::nanoseconds long_tape_start_after(const ir::Tape& tape) {
     // Measured (docs/performance.md, "Long tapes"): the fast machine code of a long tape compiles in
-    // 0.10-0.15 ms per instruction (0.98 s at 9,971, 5.8 s at 38,000 with the rest of the compile).
-    constexpr double compile_ns_per_instruction = 0.15e6;
-    const double compile_ns = compile_ns_per_instruction * static_cast<double>(tape.instruction_count());
-    return static_cast<std::uint64_t>(std::max(1.0, compile_ns / interp::cover_eval_ns(tape)));
+    // 0.10-0.19 ms per instruction (0.98 s at 9,971, 2.4 s at 12,373 on a loaded machine, 5.8 s at 38,000
+    // with the rest of the compile). The compile takes a core from the cover while it runs, so it waits
+    // for three times its time in interpreted work: a job of 4.4 s of interpreted CPU against a 2.4 s
+    // compile (a depth-15 picture on two threads) ended later than the interpreter alone when it started
+    // sooner.
+    constexpr double compile_ns_per_instruction = 0.15e6, rent_factor = 3;
+    return std::chrono::nanoseconds(static_cast<std::int64_t>(std::max(
+        1.0, rent_factor * compile_ns_per_instruction * static_cast<double>(tape.instruction_count()))));
 }
 
 std::unique_ptr<ir::Evaluator> make_tiered(const ir::Tape& tape, const ir::EvalOptions& options,
                                            const JitConfig& config, TierSwitch when,
-                                           std::uint64_t start_after) {
+                                           std::chrono::nanoseconds start_after) {
     if (when == TierSwitch::when_ready && !tiers_exactly(tape))
         throw std::invalid_argument(
             "make_tiered: the tape has an inline kernel wider than the interpreter's");
@@ -547,7 +554,7 @@ std::unique_ptr<ir::Evaluator> make_tiered(const ir::Tape& tape, const ir::EvalO
     state->config = config;
     state->start_after = start_after;
     auto interp = interp::make_interpreter(tape, options);
-    if (start_after == 0) start_first_compile(state);
+    if (start_after.count() == 0) start_first_compile(state);
     return std::make_unique<TieredEvaluator>(
         std::make_shared<TierOwner>(std::move(state)), std::move(interp), nullptr,
         when == TierSwitch::when_ready ? 0 : checkpoint_evaluations(tape));

@@ -16,6 +16,7 @@
 
 #include "backend/llvm/jit.hpp"
 
+#include <chrono>
 #include <optional>
 
 namespace frac::jit {
@@ -36,16 +37,18 @@ enum class TierSwitch {
 // of a cell ask again). When compiling fails, the evaluator stays interpreted and says so once on
 // stderr. TierSwitch::when_ready requires tiers_exactly(tape) (std::invalid_argument otherwise).
 // A `config` with fast_codegen makes the fast code the last tier (no optimised compile follows).
-// `start_after` > 0 delays the compile until the interpreter has made that many evaluations (summed
-// over the evaluator and its clones; wait_for_tier starts it at once): a short job never compiles.
+// `start_after` > 0 delays the compile until the interpreter has worked that long (the time of its
+// calls, summed over the evaluator and its clones; wait_for_tier starts it at once): a short job never
+// compiles.
 std::unique_ptr<ir::Evaluator> make_tiered(const ir::Tape& tape, const ir::EvalOptions& options,
                                            const JitConfig& config, TierSwitch when = TierSwitch::when_ready,
-                                           std::uint64_t start_after = 0);
+                                           std::chrono::nanoseconds start_after = std::chrono::nanoseconds{
+                                               0});
 
-// The interpreted evaluations after which a long tape's fast compile starts: as many as take the
-// interpreter about the time the compile will take (the rent-or-buy rule: a job pays at most about
-// twice what it would with hindsight, and one shorter than the compile never compiles).
-std::uint64_t long_tape_start_after(const ir::Tape& tape);
+// The interpreter's working time after which a long tape's fast compile starts: a few times what the
+// compile will take (rent before buying: a shorter job never compiles, a longer one pays a bounded
+// multiple of what it would with hindsight).
+std::chrono::nanoseconds long_tape_start_after(const ir::Tape& tape);
 
 // Cells evaluated after which interpreting has cost about what compiling saves (measured rates on a
 // transcendental tape, bench_kernels' gyroid: the interpreter 24 ns per unit of tape cost and box, the
