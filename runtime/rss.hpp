@@ -72,9 +72,6 @@ struct RssOptions {
 // frontier of undecided cells beside them) and a few seconds to a minute of evaluation.
 inline constexpr std::uint64_t default_max_cells = std::uint64_t{1} << 27;
 
-// Default limits of the depth, reported as errors when exceeded (RssOptions::max_depth raises them).
-// Besides, split^depth must not exceed 2^32 (cell positions are 32-bit): with split 3 the depth is at
-// most 20, with split 4 at most 16.
 // The stack of the worker threads that evaluate cells (address space only: pages are touched as used).
 // Generated code keeps its spilled values on the stack: 4 MB of them for a tape of 38,000 instructions
 // compiled with LLVM's fast machine code generation, which overflowed TBB's default. A cover asks for
@@ -82,6 +79,9 @@ inline constexpr std::uint64_t default_max_cells = std::uint64_t{1} << 27;
 // other parallel work may start them first (the CLI) asks for it from the start.
 inline constexpr std::size_t worker_stack_bytes = std::size_t{256} << 20;
 
+// Default limits of the depth, reported as errors when exceeded (RssOptions::max_depth raises them).
+// Besides, split^depth must not exceed 2^32 (cell positions are 32-bit): with split 3 the depth is at
+// most 20, with split 4 at most 16.
 inline constexpr int max_depth_2d = 24;
 inline constexpr int max_depth_3d = 14;
 
