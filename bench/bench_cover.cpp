@@ -1,6 +1,7 @@
 // What a JIT cover costs beyond evaluation, and how it scales to two threads (issue 13): the carpet's
 // RSS cover against the JIT's kernel alone on the same cells (boxes in memory, eval_boxes; and the
-// cells' coordinates with their level's grid, eval_cells), and a deep cover on 1 and 2 threads.
+// cells' coordinates with their level's grid, eval_cells), and a deep cover on 1 and 2 threads, also
+// keeping its cells (as `frac render` does: RssResult::cells).
 // Every variant in this one run, repetitions interleaved, medians.
 //
 //   bench_cover [depth=10] [deep_depth=12] [reps=5]
@@ -68,7 +69,7 @@ int main(int argc, char** argv) {
         coords[cell.level].insert(coords[cell.level].end(), {cell.ix, cell.iy, 0, 0});
     std::vector<ir::CellVerdict> verdicts(n);
 
-    std::vector<double> kernel, cell_kernel, one, two, deep_one, deep_two;
+    std::vector<double> kernel, cell_kernel, one, two, deep_one, deep_two, kept_one, kept_two;
     std::uint64_t deep_cells = 0;
     for (int r = 0; r < reps; ++r) {
         auto t0 = bench::Clock::now();
@@ -86,6 +87,8 @@ int main(int argc, char** argv) {
         const rt::RssResult d1 = cover(*jt, s.box, deep, 1);
         deep_one.push_back(d1.seconds);
         deep_two.push_back(cover(*jt, s.box, deep, 2).seconds);
+        kept_one.push_back(cover(*jt, s.box, deep, 1, true).seconds);
+        kept_two.push_back(cover(*jt, s.box, deep, 2, true).seconds);
         deep_cells = d1.evaluated;
     }
     const double ns = 1e9 / double(n);
@@ -102,6 +105,9 @@ int main(int argc, char** argv) {
     fmt::print("JIT carpet cover, depth {} ({} evaluations): 1 thread {:.3f} s, 2 threads {:.3f} s, speed-up "
                "{:.2f}x\n",
                deep, deep_cells, t1, t2, t1 / t2);
+    const double k1 = median(kept_one), k2 = median(kept_two);
+    fmt::print("  keeping its cells: 1 thread {:.3f} s, 2 threads {:.3f} s, speed-up {:.2f}x\n", k1, k2,
+               k1 / k2);
     double load[3] = {0, 0, 0};
     if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
         if (std::fscanf(f, "%lf %lf %lf", &load[0], &load[1], &load[2]) != 3) load[0] = -1;
