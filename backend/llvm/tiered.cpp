@@ -165,15 +165,20 @@ public:
         return c;
     }
 
-    // False when no compile thread can be started: the caller compiles itself. `optimized`: the
-    // second compile, due at once.
-    bool enqueue(const std::shared_ptr<TierState>& s, bool optimized = false) {
+    // What a job does: the first compile, the optimised second one, or a look into the code cache
+    // for a compile that waits (probe_cache).
+    enum class Work { first, optimized, probe };
+
+    // False when no compile thread can be started: the caller compiles itself. The second compile is
+    // due at once.
+    bool enqueue(const std::shared_ptr<TierState>& s, Work work = Work::first) {
         std::lock_guard<std::mutex> lock(mu_);
         start_locked();
         if (!started_) return false;
-        jobs_.push_back(
-            {s, std::chrono::steady_clock::now() + (optimized ? std::chrono::milliseconds{0} : start_delay),
-             optimized});
+        jobs_.push_back({s,
+                         std::chrono::steady_clock::now() +
+                             (work == Work::optimized ? std::chrono::milliseconds{0} : start_delay),
+                         work});
         wake_.notify_one();
         return true;
     }
@@ -230,6 +235,30 @@ public:
         s.done.notify_all();
     }
 
+    // A first compile that waits for the interpreter's work (start_after) may find its code in the
+    // cache now: then the code is taken at once and the compile never starts. On a miss nothing
+    // changes (the look costs the IR's generation, a small part of a long tape's compile).
+    static void probe_cache(TierState& s) {
+        if (s.started.load(std::memory_order_acquire)) return; // the compile is queued: it looks itself
+        JitConfig cached = s.config;
+        cached.cache_only = true;
+        std::unique_ptr<ir::Evaluator> code;
+        try {
+            code = make_jit(s.tape, s.options, cached);
+        } catch (const std::exception&) {
+            return; // not cached (or not compilable: the compile will say so)
+        }
+        // The interpreter's work may have queued the compile meanwhile; that compile finds the cache.
+        if (s.started.exchange(true, std::memory_order_acq_rel)) return;
+        s.jit = std::move(code);
+        s.first_is_optimized = true; // nothing better is compiled after the code of s.config
+        {
+            std::lock_guard<std::mutex> lock(s.done_mu);
+            s.phase.store(Phase::ready, std::memory_order_release);
+        }
+        s.done.notify_all();
+    }
+
     // The optimised compile; when it fails the fast code stays.
     static void compile_optimized(TierState& s) {
         try {
@@ -271,7 +300,7 @@ private:
 
     void loop() {
         std::shared_ptr<TierState> s;
-        bool optimized = false;
+        Work work = Work::first;
         for (;;) {
             {
                 std::unique_lock<std::mutex> lock(mu_);
@@ -288,12 +317,14 @@ private:
                     continue;
                 }
                 s = std::move(jobs_.front().state);
-                optimized = jobs_.front().optimized;
+                work = jobs_.front().work;
                 jobs_.pop_front();
                 current_ = s.get();
             }
-            if (optimized) {
+            if (work == Work::optimized) {
                 compile_optimized(*s);
+            } else if (work == Work::probe) {
+                probe_cache(*s);
             } else {
                 JitConfig first = s->config;
                 first.fast_codegen = true;
@@ -307,7 +338,7 @@ private:
     struct Job {
         std::shared_ptr<TierState> state;
         std::chrono::steady_clock::time_point due; // not started before
-        bool optimized = false;                    // the second compile
+        Work work = Work::first;
     };
     std::deque<Job> jobs_;
     const TierState* current_ = nullptr; // being compiled
@@ -495,7 +526,7 @@ private:
         if (done < s.optimize_at.load(std::memory_order_relaxed) ||
             s.optimize_asked.exchange(true, std::memory_order_relaxed))
             return;
-        Compiler::get().enqueue(owner_->state, /*optimized=*/true);
+        Compiler::get().enqueue(owner_->state, Compiler::Work::optimized);
     }
 
     std::shared_ptr<TierOwner> owner_;
@@ -554,7 +585,10 @@ std::unique_ptr<ir::Evaluator> make_tiered(const ir::Tape& tape, const ir::EvalO
     state->config = config;
     state->start_after = start_after;
     auto interp = interp::make_interpreter(tape, options);
-    if (start_after.count() == 0) start_first_compile(state);
+    if (start_after.count() == 0)
+        start_first_compile(state);
+    else if (!config.cache_dir.empty())
+        Compiler::get().enqueue(state, Compiler::Work::probe); // a warm cache serves before the delay
     return std::make_unique<TieredEvaluator>(
         std::make_shared<TierOwner>(std::move(state)), std::move(interp), nullptr,
         when == TierSwitch::when_ready ? 0 : checkpoint_evaluations(tape));

@@ -293,3 +293,40 @@ TEST_CASE("with a warm code cache the tiered engine starts on the optimised code
                     jit::NotCached);
     std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("a compile that waits for the interpreter's work takes warm cached code at once",
+          "[llvm][tiered]") {
+    const Model m = compile(scene);
+    const ir::Tape& tape = only_tape(m);
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("frac-test-tiered-probe-" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir);
+    jit::JitConfig config;
+    config.cache_dir = (dir / "cache").string();
+    const std::vector<Interval> box{{-0.5, 0.25}, {0.1, 0.2}};
+    const auto idle = [] {
+        while (jit::background_compile_pending()) std::this_thread::sleep_for(std::chrono::milliseconds{1});
+    };
+    const std::chrono::nanoseconds hour = std::chrono::hours{1};
+    {
+        // A cold cache: the look into it finds nothing, and the compile still waits.
+        auto tiered = jit::make_tiered(tape, {}, config, jit::TierSwitch::when_ready, hour);
+        idle();
+        tiered->eval_box(box.data());
+        CHECK(jit::tier_status(*tiered)->tier == jit::Tier::interpreter);
+        CHECK_FALSE(jit::tier_status(*tiered)->compile_started);
+    }
+    const Interval want = jit::make_jit(tape, {}, config)->eval_box(box.data());
+    // A warm one: the code is taken without waiting an hour of interpreted work.
+    auto tiered = jit::make_tiered(tape, {}, config, jit::TierSwitch::when_ready, hour);
+    idle();
+    CHECK(same(tiered->eval_box(box.data()), want));
+    CHECK(jit::tier_status(*tiered)->tier == jit::Tier::optimized);
+    CHECK(jit::tier_status(*tiered)->compile_started);
+    // Without a cache there is nothing to look into.
+    auto uncached = jit::make_tiered(tape, {}, {}, jit::TierSwitch::when_ready, hour);
+    idle();
+    uncached->eval_box(box.data());
+    CHECK(jit::tier_status(*uncached)->tier == jit::Tier::interpreter);
+    std::filesystem::remove_all(dir);
+}
