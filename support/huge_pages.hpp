@@ -1,0 +1,24 @@
+// Large buffers backed by transparent huge pages where the kernel offers them on request
+// (/sys/kernel/mm/transparent_hugepage/enabled = madvise, the default of many distributions): one page
+// fault per 2 MB instead of one per 4 KB. A deep cover writes hundreds of megabytes of cells once; in a
+// virtual machine each 4 KB fault costs microseconds (docs/performance.md, "Huge pages for covers").
+// Only advice: where the kernel has no huge pages, or the call fails, nothing changes.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+namespace frac::support {
+
+// Asks for huge pages on the 2 MB-aligned part of [data, data + bytes) (memory not yet touched, such as
+// a buffer just reserved, gets them at its first fault).
+void advise_huge_pages(const void* data, std::size_t bytes);
+
+// v.reserve(n), then the advice for its whole capacity.
+template <class T>
+void reserve_huge(std::vector<T>& v, std::size_t n) {
+    v.reserve(n);
+    advise_huge_pages(v.data(), v.capacity() * sizeof(T));
+}
+
+} // namespace frac::support
