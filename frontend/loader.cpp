@@ -28,15 +28,22 @@ bool read_file(const std::string& path, std::size_t max_file_bytes, std::string&
         why = std::strerror(errno);
         return false;
     }
-    // At most one byte over the limit is read, so a device without end (/dev/zero) stops at the limit;
-    // a failed read (/proc/self/mem) is an error, not an empty file.
-    text.assign(max_file_bytes + 1, '\0');
-    in.read(text.data(), static_cast<std::streamsize>(text.size()));
-    if (in.bad()) {
-        why = "read error";
-        return false;
+    // Read in chunks (room for the whole limit at once would be written, and faulted in, for every
+    // file: 16 MB per import). At most one byte over the limit is read, so a device without end
+    // (/dev/zero) stops at the limit; a failed read (/proc/self/mem) is an error, not an empty file.
+    constexpr std::size_t chunk = std::size_t{64} << 10;
+    text.clear();
+    while (text.size() <= max_file_bytes) {
+        const std::size_t have = text.size();
+        text.resize(have + std::min(chunk, max_file_bytes + 1 - have));
+        in.read(text.data() + have, static_cast<std::streamsize>(text.size() - have));
+        text.resize(have + static_cast<std::size_t>(in.gcount()));
+        if (in.bad()) {
+            why = "read error";
+            return false;
+        }
+        if (!in) break; // the end of the file
     }
-    text.resize(static_cast<std::size_t>(in.gcount()));
     if (text.size() > max_file_bytes) {
         why = fmt::format("larger than the limit of {} MiB{}", max_file_bytes >> 20,
                           raised_by("FRAC_MAX_FILE_MB"));
