@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <iterator>
 #include <vector>
 
 namespace frac::support {
@@ -14,11 +15,16 @@ namespace frac::support {
 // a buffer just reserved, gets them at its first fault).
 void advise_huge_pages(const void* data, std::size_t bytes);
 
-// v.reserve(n), then the advice for its whole capacity.
+// v.reserve(n) with the advice given before v's elements move into the new room (so that their copy
+// faults huge pages in as well).
 template <class T>
 void reserve_huge(std::vector<T>& v, std::size_t n) {
-    v.reserve(n);
-    advise_huge_pages(v.data(), v.capacity() * sizeof(T));
+    if (n <= v.capacity()) return;
+    std::vector<T> room;
+    room.reserve(n);
+    advise_huge_pages(room.data(), room.capacity() * sizeof(T));
+    room.insert(room.end(), std::make_move_iterator(v.begin()), std::make_move_iterator(v.end()));
+    v.swap(room);
 }
 
 } // namespace frac::support
