@@ -27,10 +27,11 @@ constexpr std::size_t jit_max_prunable_instructions = 1000;
 // optimised one grows about quadratically with the length of one function (its machine scheduler; a
 // sum of n square roots: 4.1 s at 10,000 instructions, 18.8 s at 20,000), the fast one linearly (1.0 s
 // and 2.4 s), and its code still evaluates a box about 3 times faster than the interpreter. The default
-// engine interprets it until the interpreter has worked three times what the compile will take
-// (jit::long_tape_start_after), then compiles in the background: a compile of seconds started at once
-// beside a cover on two cores made it slower than the interpreter (a depth-15 picture of 12,400
-// instructions: 3.15 s against 2.28; docs/performance.md, "Long tapes").
+// engine interprets it until the work to come (a cover foresees it, Evaluator::foresee), else the work
+// done, is three times what the compile will take (jit::long_tape_start_after), then compiles in the
+// background: a compile of seconds started at once beside a cover on two cores made it slower than the
+// interpreter (a depth-15 picture of 12,400 instructions: 3.15 s against 2.28; docs/performance.md,
+// "Long tapes").
 constexpr std::size_t jit_max_optimized_instructions = 10000;
 
 // Any tape longer than this is interpreted, whatever the engine asked for: the fast machine code

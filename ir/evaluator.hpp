@@ -173,6 +173,11 @@ public:
     // evaluator whose two engines' bits may differ changes engine only here (backend/llvm/tiered.hpp),
     // so that the output does not depend on when its compile finished.
     virtual void checkpoint(std::uint64_t evaluated) {}
+    // The evaluations the caller foresees asking of this evaluator and its clones from now on (a cover:
+    // at the start of a level, the cells to its depth as the frontier's growth foretells them). A tiered
+    // evaluator that waits before it compiles (a long tape) compiles when that work would repay it,
+    // and no longer by the time it has interpreted.
+    virtual void foresee(double evaluations) {}
     // Instructions of the function this evaluator computes (its tape).
     virtual std::size_t instruction_count() const { return 0; }
 

@@ -234,6 +234,9 @@ public:
         evaluate_level();
         for (int k = 1; k <= depth; ++k) {
             check_budget(k, next_.size());
+            // The work left, once the growth is told by enough cells (an engine that waits to compile
+            // compiles when that work repays it).
+            if (next_.size() >= min_cells_for_growth) f_.foresee(cells_foreseen(k, next_.size()));
             // The two frontiers swap buffers: no level regrows (and faults in) a fresh one.
             parents_.swap(next_);
             next_.clear();
@@ -280,13 +283,7 @@ private:
         const double per_parent = std::pow(static_cast<double>(r_.split), d_);
         const double next = static_cast<double>(parents) * per_parent;
         const double done = static_cast<double>(r_.evaluated);
-        // Growth of the undecided cells per level, from the last two levels (at least 1).
-        const double before =
-            k >= 2 ? static_cast<double>(r_.levels[static_cast<std::size_t>(k - 2)].undecided) : 1;
-        const double growth =
-            std::clamp(before > 0 ? static_cast<double>(parents) / before : per_parent, 1.0, per_parent);
-        double estimate = done, frontier = static_cast<double>(parents);
-        for (int j = k; j <= r_.depth; ++j, frontier *= growth) estimate += frontier * per_parent;
+        const double estimate = done + cells_foreseen(k, parents);
         const bool exact = done + next > static_cast<double>(limit);
         const bool foretold = parents >= min_cells_for_growth && estimate > static_cast<double>(limit);
         if (!exact && !foretold) return;
@@ -296,6 +293,19 @@ private:
                                      "limit of {} cells (foreseen after level {} of {})",
                                      r_.depth, estimate, byte_text(bytes), limit, k - 1, r_.depth),
                          estimate, limit);
+    }
+
+    // The cells of levels k to the depth, from the `parents` undecided cells of level k - 1 and the
+    // growth of the undecided cells per level over the last two levels (at least 1).
+    double cells_foreseen(int k, std::size_t parents) const {
+        const double per_parent = std::pow(static_cast<double>(r_.split), d_);
+        const double before =
+            k >= 2 ? static_cast<double>(r_.levels[static_cast<std::size_t>(k - 2)].undecided) : 1;
+        const double growth =
+            std::clamp(before > 0 ? static_cast<double>(parents) / before : per_parent, 1.0, per_parent);
+        double cells = 0, frontier = static_cast<double>(parents);
+        for (int j = k; j <= r_.depth; ++j, frontier *= growth) cells += frontier * per_parent;
+        return cells;
     }
 
     void start_level(int k) {

@@ -130,8 +130,10 @@ struct TierState {
     JitConfig config; // the optimised code's (unless fast_codegen); the first compile's has fast_codegen
     // The first compile starts once the interpreter has worked this long (0: at once).
     std::chrono::nanoseconds start_after{0};
-    std::atomic<std::int64_t> interpreted_ns{0}; // every evaluator's, summed
-    std::atomic<bool> started{false};            // the first compile is queued (or done)
+    std::atomic<std::int64_t> interpreted_ns{0};     // every evaluator's, summed ...
+    std::atomic<std::uint64_t> interpreted_calls{0}; // ... for these evaluations
+    std::atomic<bool> foreseen{false};               // a caller tells the work to come (foresee)
+    std::atomic<bool> started{false};                // the first compile is queued (or done)
     std::atomic<Phase> phase{Phase::queued};
     std::unique_ptr<ir::Evaluator> jit; // written before phase becomes ready, then only read
     std::string error;                  // written before phase becomes failed
@@ -421,6 +423,21 @@ public:
         return p;
     }
 
+    // A compile that waits for start_after of interpreted time starts when the interpreter's time for the
+    // evaluations foreseen (at its rate so far) reaches start_after instead: rent for the work to come,
+    // not for the work done, so that a job whose end is near never starts a compile it cannot repay.
+    void foresee(double evaluations) override {
+        TierState& s = *owner_->state;
+        if (s.start_after.count() == 0 || s.started.load(std::memory_order_acquire)) return;
+        s.foreseen.store(true, std::memory_order_relaxed);
+        const auto calls = s.interpreted_calls.load(std::memory_order_relaxed);
+        if (calls == 0) return; // no rate yet: the next forecast decides
+        const double ns_per_call = static_cast<double>(s.interpreted_ns.load(std::memory_order_relaxed)) /
+                                   static_cast<double>(calls);
+        if (evaluations * ns_per_call >= static_cast<double>(s.start_after.count()))
+            start_first_compile(owner_->state);
+    }
+
     void checkpoint(std::uint64_t evaluated) override {
         if (switch_after_ == when_ready || jit_ || evaluated < switch_after_) return;
         wait();
@@ -505,16 +522,18 @@ private:
         auto r = f(e);
         stats += e.stats;
         if (jit_ && !optimized_) count_towards_optimizing(e.stats.calls);
-        if (timed) count_towards_starting(std::chrono::steady_clock::now() - t0);
+        if (timed) count_towards_starting(std::chrono::steady_clock::now() - t0, e.stats.calls);
         return r;
     }
 
     // The interpreter's time, every evaluator's of the tape; past the state's start_after the first
-    // compile is queued (once).
-    void count_towards_starting(std::chrono::nanoseconds spent) {
+    // compile is queued (once), unless a caller foresees the work to come.
+    void count_towards_starting(std::chrono::nanoseconds spent, std::uint64_t calls) {
         TierState& s = *owner_->state;
+        s.interpreted_calls.fetch_add(calls, std::memory_order_relaxed);
         if (s.interpreted_ns.fetch_add(spent.count(), std::memory_order_relaxed) + spent.count() >=
-            s.start_after.count())
+                s.start_after.count() &&
+            !s.foreseen.load(std::memory_order_relaxed))
             start_first_compile(owner_->state);
     }
 

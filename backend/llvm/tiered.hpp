@@ -39,7 +39,9 @@ enum class TierSwitch {
 // A `config` with fast_codegen makes the fast code the last tier (no optimised compile follows).
 // `start_after` > 0 delays the compile until the interpreter has worked that long (the time of its
 // calls, summed over the evaluator and its clones; wait_for_tier starts it at once): a short job never
-// compiles. Its code in the config's cache is looked for at once (on the compile thread) and, when it
+// compiles. Once a caller foresees its work (Evaluator::foresee: a cover, at each level), the compile
+// starts instead when the interpreter's time for the work foreseen, at its rate so far, reaches
+// start_after. Its code in the config's cache is looked for at once (on the compile thread) and, when it
 // is there, taken without waiting.
 std::unique_ptr<ir::Evaluator> make_tiered(const ir::Tape& tape, const ir::EvalOptions& options,
                                            const JitConfig& config, TierSwitch when = TierSwitch::when_ready,

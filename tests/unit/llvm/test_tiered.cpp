@@ -330,3 +330,42 @@ TEST_CASE("a compile that waits for the interpreter's work takes warm cached cod
     CHECK(jit::tier_status(*uncached)->tier == jit::Tier::interpreter);
     std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("a compile that waits starts when the work foreseen would repay it, not by the time spent",
+          "[llvm][tiered]") {
+    const Model m = compile(scene);
+    const ir::Tape& tape = only_tape(m);
+    const std::vector<Interval> box{{-0.5, 0.25}, {0.1, 0.2}};
+    const Interval want = jit::make_jit(tape)->eval_box(box.data());
+    {
+        // An hour of interpreted work to repay: a forecast of a thousand evaluations does not start
+        // the compile, one of 10^18 does.
+        auto tiered = jit::make_tiered(tape, {}, {}, jit::TierSwitch::when_ready, std::chrono::hours{1});
+        tiered->foresee(1e18); // no rate measured yet: nothing is decided
+        CHECK_FALSE(jit::tier_status(*tiered)->compile_started);
+        for (int i = 0; i < 100; ++i) CHECK(same(tiered->eval_box(box.data()), want));
+        tiered->foresee(1000);
+        CHECK_FALSE(jit::tier_status(*tiered)->compile_started);
+        tiered->clone()->foresee(1e18); // clones share the state
+        CHECK(jit::tier_status(*tiered)->compile_started);
+        jit::wait_for_tier(*tiered);
+        CHECK(same(tiered->eval_box(box.data()), want));
+        CHECK(jit::tier_status(*tiered)->tier != jit::Tier::interpreter);
+    }
+    {
+        // Once the work to come is foreseen, the time spent no longer starts it: 1 ns of interpreted
+        // work would have.
+        auto tiered =
+            jit::make_tiered(tape, {}, {}, jit::TierSwitch::when_ready, std::chrono::nanoseconds{1});
+        tiered->foresee(0);
+        for (int i = 0; i < 100; ++i) CHECK(same(tiered->eval_box(box.data()), want));
+        CHECK_FALSE(jit::tier_status(*tiered)->compile_started);
+        CHECK(jit::tier_status(*tiered)->tier == jit::Tier::interpreter);
+    }
+    {
+        // A compile that starts at once has nothing to decide.
+        auto tiered = jit::make_tiered(tape, {}, {});
+        tiered->foresee(0);
+        CHECK(jit::tier_status(*tiered)->compile_started);
+    }
+}

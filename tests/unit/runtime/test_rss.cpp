@@ -554,3 +554,55 @@ TEST_CASE("rss: option and box validation", "[rss]") {
     CHECK_THROWS_WITH(subdivide(disk, square, o), Contains("batch"));
     CHECK_THROWS_AS(subdivide(disk, square, opts(30)), std::invalid_argument);
 }
+
+namespace {
+
+// A disk that counts its evaluations (over its clones) and records the cover's forecasts.
+struct ForecastLog {
+    std::mutex mu;
+    std::uint64_t evaluated = 0;
+    std::vector<std::pair<std::uint64_t, double>> forecasts; // (evaluated before it, cells foreseen)
+};
+
+class ForeseenDisk : public Disk {
+public:
+    ForeseenDisk(std::shared_ptr<ForecastLog> log) : Disk(0.1, 0.2, 0.7), log_(std::move(log)) {}
+    void eval_boxes(const Interval* boxes, std::size_t n, Interval* out) override {
+        Disk::eval_boxes(boxes, n, out);
+        std::lock_guard<std::mutex> lock(log_->mu);
+        log_->evaluated += n;
+    }
+    void foresee(double evaluations) override {
+        std::lock_guard<std::mutex> lock(log_->mu);
+        log_->forecasts.emplace_back(log_->evaluated, evaluations);
+    }
+    std::unique_ptr<Evaluator> clone() const override { return std::make_unique<ForeseenDisk>(*this); }
+
+private:
+    std::shared_ptr<ForecastLog> log_;
+};
+
+} // namespace
+
+TEST_CASE("a cover tells its evaluator the cells it foresees to its depth, once the growth is known",
+          "[rss]") {
+    for (int threads : {1, 2}) {
+        auto log = std::make_shared<ForecastLog>();
+        ForeseenDisk disk(log);
+        RssOptions o;
+        o.depth = 14;
+        o.threads = threads;
+        const RssResult r = subdivide(disk, {{-1, 1}, {-1, 1}}, o);
+        REQUIRE(log->evaluated == r.evaluated);
+        // A circle's frontier doubles per level: from about 4,096 undecided cells on (level 10 of 14),
+        // one forecast per level, each within 10% of the cells the cover then evaluated.
+        CHECK(log->forecasts.size() >= 3);
+        CHECK(log->forecasts.size() <= 5);
+        for (const auto& [before, foreseen] : log->forecasts) {
+            const double left = static_cast<double>(r.evaluated - before);
+            INFO("foreseen " << foreseen << " left " << left);
+            CHECK(foreseen >= 0.9 * left);
+            CHECK(foreseen <= 1.1 * left);
+        }
+    }
+}
