@@ -23,8 +23,9 @@ namespace fs = std::filesystem;
 constexpr char magic[8] = {'F', 'R', 'A', 'C', 'O', 'B', 'J', '1'};
 constexpr std::size_t header_bytes = sizeof(magic) + 8 + 32;
 // Bump when the object a module compiles to may change for the same IR: the helpers' calling
-// conventions (helpers.cpp), the pass pipeline (pipeline.cpp), the code generation level (jit.cpp).
-constexpr std::string_view cache_format = "frac-jit-cache-1";
+// conventions (helpers.cpp), the pass pipeline (pipeline.cpp), the code generation level (jit.cpp),
+// the form of the key (2: the module's bitcode instead of its printed IR).
+constexpr std::string_view cache_format = "frac-jit-cache-2";
 
 llvm::BLAKE3Result<32> digest(std::string_view bytes) {
     llvm::BLAKE3 h;
@@ -34,10 +35,11 @@ llvm::BLAKE3Result<32> digest(std::string_view bytes) {
 
 } // namespace
 
-std::string CodeCache::key(std::string_view ir_text, std::string_view target) {
+std::string CodeCache::key(std::string_view module_bitcode, std::string_view target) {
     llvm::BLAKE3 h;
     // Each part with its length, so that no two different inputs hash the same bytes.
-    for (std::string_view part : {cache_format, std::string_view(LLVM_VERSION_STRING), target, ir_text}) {
+    for (std::string_view part :
+         {cache_format, std::string_view(LLVM_VERSION_STRING), target, module_bitcode}) {
         const std::uint64_t n = part.size();
         h.update(llvm::ArrayRef<std::uint8_t>(reinterpret_cast<const std::uint8_t*>(&n), sizeof n));
         h.update(llvm::StringRef(part.data(), part.size()));

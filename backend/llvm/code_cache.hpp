@@ -1,6 +1,6 @@
 // The JIT's on-disk cache of machine code: a tape compiled once is loaded, not compiled, by later
-// processes. Keyed by a BLAKE3 hash of the generated LLVM IR before optimisation (which holds the
-// tape, its tables, the rounding form and the vector width) and of everything else that decides the
+// processes. Keyed by a BLAKE3 hash of the generated module's bitcode before optimisation (which holds
+// the tape, its tables, the rounding form and the vector width) and of everything else that decides the
 // object: LLVM's version, the host's CPU and features, and this cache's format (bump it when the
 // helpers' calling conventions or the pass pipeline change). One file per key,
 //
@@ -29,8 +29,8 @@ public:
     // `dir` is created on the first store; `target` names what the IR does not say (CPU, features).
     CodeCache(std::string dir, std::size_t max_bytes) : dir_(std::move(dir)), max_bytes_(max_bytes) {}
 
-    // The key of a module: its IR text and the target.
-    static std::string key(std::string_view ir_text, std::string_view target);
+    // The key of a module: its bitcode and the target.
+    static std::string key(std::string_view module_bitcode, std::string_view target);
 
     // The verified object of `key`, or null on a miss.
     std::unique_ptr<llvm::MemoryBuffer> load(const std::string& key) const;

@@ -8,6 +8,7 @@
 #include "backend/llvm/tables.hpp"
 #include "ir/specialize.hpp"
 
+#include <llvm/Bitcode/BitcodeWriter.h>
 #include <llvm/ExecutionEngine/Orc/CompileUtils.h>
 #include <llvm/ExecutionEngine/Orc/Core.h>
 #include <llvm/ExecutionEngine/Orc/JITTargetMachineBuilder.h>
@@ -399,10 +400,12 @@ std::shared_ptr<const Compiled> compile(const ir::Tape& tape, const ir::EvalOpti
     if (!config.cache_dir.empty() && !calls_externals(tape)) {
         t = Clock::now();
         cache.emplace(config.cache_dir, config.cache_max_bytes);
-        std::string ir;
-        llvm::raw_string_ostream os(ir);
-        g.module->print(os, nullptr);
-        key = CodeCache::key(os.str(), engine->target_of(config));
+        // The module's bitcode (deterministic, like its text, and written about 10x faster than the
+        // text is printed: 0.5 s of a 12,000-instruction tape's cache hit was printing).
+        llvm::SmallVector<char, 0> bitcode;
+        llvm::raw_svector_ostream os(bitcode);
+        llvm::WriteBitcodeToFile(*g.module, os);
+        key = CodeCache::key(std::string_view(bitcode.data(), bitcode.size()), engine->target_of(config));
         object = cache->load(key);
         info.cache = object ? "hit" : "miss";
         info.cache_ms = ms_since(t);

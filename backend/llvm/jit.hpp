@@ -109,7 +109,7 @@ struct CompileInfo {
     // The on-disk cache: "off" (none, or the tape calls external functions), "miss" (compiled, then
     // stored) or "hit" (loaded: no optimisation, no code generation).
     std::string cache = "off";
-    double cache_ms = 0; // printing and hashing the IR, reading or writing the entry
+    double cache_ms = 0; // writing and hashing the module's bitcode, reading or writing the entry
 };
 // The compile info of a JIT evaluator (or a clone); nullptr for any other engine.
 const CompileInfo* compile_info(const ir::Evaluator& e);
