@@ -1,4 +1,5 @@
 #include "runtime/legend.hpp"
+#include "support/huge_pages.hpp"
 
 #include <algorithm>
 #include <array>
@@ -76,7 +77,9 @@ Image with_legend(const Image& image, PictureKind kind) {
     Image out;
     out.width = image.width;
     out.height = image.height + strip;
-    out.rgb.assign(static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height) * 3, 255);
+    support::assign_huge(out.rgb,
+                         static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height) * 3,
+                         std::uint8_t{255});
     std::copy(image.rgb.begin(), image.rgb.end(), out.rgb.begin());
     Canvas canvas(out, image.height);
     const std::vector<Entry> process = {

@@ -1,5 +1,6 @@
 #include "runtime/picture.hpp"
 #include "support/atomic_file.hpp"
+#include "support/huge_pages.hpp"
 
 #include <fmt/format.h>
 #include <png.h>
@@ -89,9 +90,10 @@ struct Raster {
     int w, h;
     std::vector<std::uint8_t> paint, line;
 
-    Raster(int w_, int h_)
-        : w(w_), h(h_), paint(static_cast<std::size_t>(w_) * h_, none),
-          line(static_cast<std::size_t>(w_) * h_, 0) {}
+    Raster(int w_, int h_) : w(w_), h(h_) {
+        support::assign_huge(paint, static_cast<std::size_t>(w_) * h_, std::uint8_t{none});
+        support::assign_huge(line, static_cast<std::size_t>(w_) * h_, std::uint8_t{0});
+    }
     std::size_t at(std::uint64_t x, std::uint64_t y) const { return y * static_cast<std::uint64_t>(w) + x; }
 };
 
@@ -263,7 +265,7 @@ Image render(const Cover& r, PictureKind kind, int pixels) {
     Image img;
     img.width = kind == PictureKind::both ? 2 * size.w + gap : size.w;
     img.height = size.h;
-    img.rgb.assign(static_cast<std::size_t>(img.width) * img.height * 3, 255);
+    support::assign_huge(img.rgb, static_cast<std::size_t>(img.width) * img.height * 3, std::uint8_t{255});
     if (kind != PictureKind::cover) blit(rasterize(r, size, true), true, img, 0);
     if (kind != PictureKind::process)
         blit(rasterize(r, size, false), false, img, kind == PictureKind::both ? size.w + gap : 0);

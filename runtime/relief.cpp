@@ -1,4 +1,5 @@
 #include "runtime/relief.hpp"
+#include "support/huge_pages.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -55,7 +56,7 @@ Image relief_image(const Cover& r, int pixels) {
     Image img;
     img.width = width;
     img.height = height;
-    img.rgb.assign(W * H * 3, 255);
+    support::assign_huge(img.rgb, W * H * 3, std::uint8_t{255});
     for (std::uint64_t y = 0; y < H; ++y)
         for (std::uint64_t x = 0; x < W; ++x) {
             const std::uint64_t k = y * W + x;

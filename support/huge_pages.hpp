@@ -27,4 +27,12 @@ void reserve_huge(std::vector<T>& v, std::size_t n) {
     v.swap(room);
 }
 
+// v = n copies of `value`, in room with the advice (pictures: hundreds of megabytes written once).
+template <class T>
+void assign_huge(std::vector<T>& v, std::size_t n, const T& value) {
+    v.clear();
+    reserve_huge(v, n);
+    v.assign(n, value);
+}
+
 } // namespace frac::support
