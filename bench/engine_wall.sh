@@ -25,7 +25,8 @@ jobs=(
     "sum3000 d17|$work/long_sum.frac --depth 17"
 )
 # A long tape (12,373 instructions: the mean of 3,000 distances, nothing to prune): the default engine
-# compiles it only once the interpreter has worked three times what the compile will take (driver/engines.cpp).
+# compiles it only once the interpreted work a cover foresees to its depth is three times what the compile will
+# take, or at once from a warm cache (driver/engines.cpp).
 awk 'BEGIN {
     printf "shape s(x, y) over [-1, 1] * [-1, 1] = (";
     for (i = 0; i < 3000; ++i)
