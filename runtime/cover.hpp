@@ -6,6 +6,7 @@
 
 #include "ir/evaluator.hpp"
 #include "numeric/interval.hpp"
+#include "support/fill_later.hpp"
 
 #include <cstdint>
 #include <vector>
@@ -23,6 +24,10 @@ struct Cell {
     std::uint32_t ix = 0, iy = 0, iz = 0;
 };
 
+// Cells in memory; resize() leaves new cells unwritten (support::FillLater): a subdivision sizes a
+// level's cells, then its threads write them.
+using CellList = std::vector<Cell, support::FillLater<Cell>>;
+
 struct LevelCounts {
     std::uint64_t evaluated = 0, inside = 0, outside = 0, undecided = 0;
 };
@@ -33,7 +38,7 @@ struct Cover {
     int split = 2;              // parts per axis and level
     // The cells, when kept: ordered by level, then within a level by position (iz, then iy, then ix:
     // row-major, x fastest). A leaf is a cell of class inside, outside or boundary.
-    std::vector<Cell> cells;
+    CellList cells;
     std::vector<LevelCounts> levels; // index = level, 0..depth
     // Totals over all levels; evaluated = inside + outside + boundary + subdivided.
     std::uint64_t evaluated = 0, inside = 0, outside = 0, boundary = 0, subdivided = 0;

@@ -92,8 +92,10 @@ struct Variant {
 // A chunk of a batch: cells [begin, end) of the batch.
 struct Chunk {
     std::size_t begin, end;
-    // What its cells gave: counts, and (from begin in Batch::undecided) its undecided cells.
-    std::uint64_t inside = 0, outside = 0, undecided = 0, pruned_cells = 0;
+    // What its cells gave: counts, and (from begin in Batch::undecided) its undecided cells; below
+    // the depth also (from begin in Batch::cells, compacted) the undecided cells themselves, and (from
+    // begin in Batch::rows) where rows of them start after the first.
+    std::uint64_t inside = 0, outside = 0, undecided = 0, pruned_cells = 0, rows = 0;
     double instructions = 0; // of the functions its cells evaluated
 };
 
@@ -103,7 +105,7 @@ struct Batch {
     std::vector<Pos> cells;               // made by the chunks
     std::vector<CellVerdict> verdicts;    // ... and what they gave
     std::vector<std::uint32_t> undecided; // each chunk's undecided cells, from its begin
-    std::vector<Cell> kept;               // the cells as kept (keep_cells)
+    std::vector<std::uint32_t> rows;      // each chunk's row starts among them, from its begin
     // Pruned functions asked for by the chunks (for variants whose evaluators answer independently of
     // each other: the cells of a level ask on every thread at once).
     std::vector<std::shared_ptr<ir::Evaluator>> pruned;
@@ -143,14 +145,19 @@ ChunkScratch& scratch() {
     return s;
 }
 
+// Batches of a level in flight on several threads: one filled while the others evaluate. The thread
+// that takes a batch's verdicts waits only for the oldest, so the other threads have the newer ones
+// to evaluate meanwhile (with two in flight they could run dry).
+constexpr int batches_in_flight = 3;
+
 // Buffers a run leaves to the next run on its thread (covers in a loop: benchmarks, tests, a library's
 // caller), so that the next one neither allocates nor faults them in again; each up to
 // kept_buffer_bytes, so that a deep cover does not hold its memory afterwards.
 struct KeptBuffers {
     std::vector<Pos> frontiers[2];
-    std::vector<Pos> cells[2];
-    std::vector<CellVerdict> verdicts[2];
-    std::vector<std::uint32_t> undecided[2];
+    std::vector<Pos> cells[batches_in_flight];
+    std::vector<CellVerdict> verdicts[batches_in_flight];
+    std::vector<std::uint32_t> undecided[batches_in_flight];
 };
 constexpr std::size_t kept_buffer_bytes = std::size_t{16} << 20;
 
@@ -197,7 +204,7 @@ public:
         KeptBuffers& k = kept_buffers();
         take_buffer(next_, k.frontiers[0]);
         take_buffer(parents_, k.frontiers[1]);
-        for (int i = 0; i < 2; ++i) {
+        for (int i = 0; i < batches_in_flight; ++i) {
             take_buffer(batches_[i].cells, k.cells[i]);
             take_buffer(batches_[i].verdicts, k.verdicts[i]);
             take_buffer(batches_[i].undecided, k.undecided[i]);
@@ -217,7 +224,7 @@ public:
         KeptBuffers& k = kept_buffers();
         leave_buffer(k.frontiers[0], next_);
         leave_buffer(k.frontiers[1], parents_);
-        for (int i = 0; i < 2; ++i) {
+        for (int i = 0; i < batches_in_flight; ++i) {
             leave_buffer(k.cells[i], batches_[i].cells);
             leave_buffer(k.verdicts[i], batches_[i].verdicts);
             leave_buffer(k.undecided[i], batches_[i].undecided);
@@ -252,14 +259,23 @@ public:
             const double children = static_cast<double>(parents_.size()) * std::pow(r_.split, d_);
             const double foreseen_undecided = children * std::min(1.0, share * 1.125);
             if (k < depth) support::reserve_huge(next_, static_cast<std::size_t>(foreseen_undecided));
-            // Kept cells: room for this level's and (foreseen the same way) the next level's at once.
-            // Grown by doubling, the copy and the page faults of a regrowth came all at once on the
-            // thread that takes the verdicts: 0.2 s of a depth-12 carpet cover (12.7 million cells, 200
-            // MB), on one thread or two.
-            if (r_.options.keep_cells && r_.cells.capacity() < r_.cells.size() + level_cells_) {
-                const double next = k < depth ? foreseen_undecided * std::pow(r_.split, d_) : 0;
-                support::reserve_huge(r_.cells,
-                                      r_.cells.size() + level_cells_ + static_cast<std::size_t>(next));
+            // Kept cells: room for this level's and the next level's (foreseen the same way) at once,
+            // and once the growth is told by enough cells, for all levels foreseen to the depth (plus
+            // 1/8; at most the cell limit). Grown by doubling, the copy and the page faults of a
+            // regrowth came all at once on this thread: 0.2 s of a depth-12 carpet cover (12.7 million
+            // cells, 200 MB), on one thread or two; room for one level ahead still copied the cells kept
+            // so far at every other level (5 ms a cover).
+            const std::size_t kept_needed = r_.cells.size() + level_cells_;
+            if (r_.options.keep_cells && r_.cells.capacity() < kept_needed) {
+                double room = static_cast<double>(kept_needed) +
+                              (k < depth ? foreseen_undecided * std::pow(r_.split, d_) : 0);
+                if (parents_.size() >= min_cells_for_growth)
+                    room = std::max(room, 1.125 * (static_cast<double>(r_.cells.size()) +
+                                                   cells_foreseen(k, parents_.size())));
+                const std::uint64_t limit =
+                    r_.options.max_cells > 0 ? r_.options.max_cells : default_max_cells;
+                room = std::min(room, static_cast<double>(std::max<std::uint64_t>(limit, kept_needed)));
+                support::reserve_huge(r_.cells, static_cast<std::size_t>(room));
             }
             evaluate_level();
         }
@@ -351,6 +367,9 @@ private:
 
     // Evaluates the level's cells, from the plan of start_level, batch by batch.
     void evaluate_level() {
+        // The level's kept cells, written by the chunks in place (unwritten until then: CellList).
+        kept_base_ = r_.cells.size();
+        if (r_.options.keep_cells) r_.cells.resize(kept_base_ + level_cells_);
         for (std::uint64_t c = 0; c < level_cells_;) {
             std::uint64_t end = std::min<std::uint64_t>(c + flush_at_, level_cells_);
             if (keep_siblings_) end = sibling_cut(c, end);
@@ -456,10 +475,11 @@ private:
 
     // Evaluates cells [first, first + m) of the level and classifies them. With several threads the
     // batch runs in the background (each chunk makes its cells, their boxes, evaluates and classifies
-    // them, and asks for pruned functions of interpreted variants: a tape push depends on nothing
-    // shared) while this thread takes the verdicts of the previous batch: counts, the next frontier,
-    // kept cells, pruning requests of JIT variants. The verdicts and the pruned functions are taken
-    // batch by batch in the level's order, so the output does not depend on the threads.
+    // them, writes them to their place among the kept cells, and asks for pruned functions of
+    // interpreted variants: a tape push depends on nothing shared) while this thread takes the verdicts
+    // of older batches: counts, the next frontier, pruning requests of JIT variants. The verdicts and
+    // the pruned functions are taken batch by batch in the level's order, so the output does not
+    // depend on the threads.
     void flush(std::uint64_t first, std::size_t m) {
         Batch& b = batches_[filling_];
         prepare(b, first, m);
@@ -480,8 +500,8 @@ private:
             });
         });
         b.running = true;
-        filling_ ^= 1;
-        drain_one(batches_[filling_]); // the batch before, if it still has verdicts to give
+        filling_ = (filling_ + 1) % batches_in_flight;
+        drain_one(batches_[filling_]); // the oldest batch, if it still has verdicts to give
     }
 
     // Waits for a running batch and takes its verdicts.
@@ -494,11 +514,10 @@ private:
 
     // Every batch's verdicts taken, oldest first (the one to fill next is never running).
     void drain() {
-        drain_one(batches_[filling_ ^ 1]);
-        drain_one(batches_[filling_]);
+        for (int i = 0; i < batches_in_flight; ++i) drain_one(batches_[(filling_ + i) % batches_in_flight]);
     }
 
-    // Counts, frontier, kept cells and pruning requests from a batch's chunks, in the level's order.
+    // Counts, frontier and pruning requests from a batch's chunks, in the level's order.
     void take_verdicts(Batch& b) {
         const bool last = level_ == r_.depth;
         LevelCounts& lc = r_.levels[static_cast<std::size_t>(level_)];
@@ -510,22 +529,22 @@ private:
             r_.pruned_evaluations += c.pruned_cells;
             pl.pruned_evaluations += c.pruned_cells;
             pl.instructions += c.instructions;
-            if (r_.options.keep_cells)
-                r_.cells.insert(r_.cells.end(), b.kept.begin() + static_cast<std::ptrdiff_t>(c.begin),
-                                b.kept.begin() + static_cast<std::ptrdiff_t>(c.end));
-            if (last) continue;
-            for (std::size_t u = c.begin; u < c.begin + c.undecided; ++u) {
-                const std::uint32_t j = b.undecided[u];
-                const Pos& p = b.cells[j];
-                if (next_.empty() || next_.back().iy != p.iy || next_.back().iz != p.iz)
-                    next_rows_.push_back(next_.size()); // a row starts (plan_children)
-                next_.push_back(p);
-                if (!consider_pruning_) continue;
+            if (last || c.undecided == 0) continue;
+            // The chunk's undecided cells, compacted by run_chunk, and where their rows start.
+            const Pos* cells = &b.cells[c.begin];
+            const std::size_t base = next_.size();
+            if (base == 0 || next_.back().iy != cells[0].iy || next_.back().iz != cells[0].iz)
+                next_rows_.push_back(base); // a row starts (plan_children)
+            for (std::size_t r = c.begin; r < c.begin + c.rows; ++r) next_rows_.push_back(base + b.rows[r]);
+            next_.insert(next_.end(), cells, cells + c.undecided);
+            if (!consider_pruning_) continue;
+            for (std::size_t u = 0; u < c.undecided; ++u) {
+                const Pos& p = cells[u];
                 const Variant& v = variants_[p.variant];
                 if (v.prune_in_chunks)
-                    next_.back().variant = adopt(p.variant, std::move(b.pruned[j]));
+                    next_[base + u].variant = adopt(p.variant, std::move(b.pruned[b.undecided[c.begin + u]]));
                 else if (v.ask_this_level)
-                    next_.back().variant = pruned_variant(p);
+                    next_[base + u].variant = pruned_variant(p);
             }
         }
         lc.evaluated += b.cells.size();
@@ -568,7 +587,7 @@ private:
         b.cells.resize(m);
         b.verdicts.resize(m);
         b.undecided.resize(m);
-        if (r_.options.keep_cells) b.kept.resize(m);
+        b.rows.resize(m);
         if (prune_in_chunks_) b.pruned.assign(m, nullptr);
         const auto k = std::max<std::size_t>(
             1,
@@ -628,17 +647,33 @@ private:
         c.inside = inside;
         c.undecided = u;
         c.outside = n - u - inside;
-        if (!r_.options.keep_cells) return;
         const bool last = level_ == r_.depth;
-        for (std::size_t i = c.begin; i < c.end; ++i) {
-            const Pos& p = b.cells[i];
-            const CellVerdict v = b.verdicts[i];
-            const CellClass cls = v == CellVerdict::inside    ? CellClass::inside
-                                  : v == CellVerdict::outside ? CellClass::outside
-                                  : last                      ? CellClass::boundary
-                                                              : CellClass::subdivided;
-            b.kept[i] = {static_cast<std::uint8_t>(level_), cls, p.ix, p.iy, p.iz};
+        if (r_.options.keep_cells) {
+            // Straight to their place among the kept cells (sized for the level by evaluate_level).
+            Cell* kept = &r_.cells[kept_base_ + b.first];
+            for (std::size_t i = c.begin; i < c.end; ++i) {
+                const Pos& p = b.cells[i];
+                const CellVerdict v = b.verdicts[i];
+                const CellClass cls = v == CellVerdict::inside    ? CellClass::inside
+                                      : v == CellVerdict::outside ? CellClass::outside
+                                      : last                      ? CellClass::boundary
+                                                                  : CellClass::subdivided;
+                kept[i] = {static_cast<std::uint8_t>(level_), cls, p.ix, p.iy, p.iz};
+            }
         }
+        if (last) return;
+        // The undecided cells to the front of the chunk's cells (in place: the u-th lies at or after
+        // begin + u), and where their rows start, so that taking them is one copy (take_verdicts).
+        Pos* cells = &b.cells[c.begin];
+        std::uint32_t* rows = &b.rows[c.begin];
+        std::size_t r = 0;
+        for (std::size_t k = 0; k < u; ++k) {
+            const Pos p = b.cells[undecided[k]];
+            if (k > 0 && (cells[k - 1].iy != p.iy || cells[k - 1].iz != p.iz))
+                rows[r++] = static_cast<std::uint32_t>(k);
+            cells[k] = p;
+        }
+        c.rows = r;
     }
 
     // Verdicts of n cells of variant `variant`, counted into the chunk. With the level's grid table and
@@ -788,15 +823,16 @@ private:
     bool keep_siblings_ = false; // cut batches and chunks between parents (sibling_cut)
     std::size_t flush_at_ = 0;
     int level_ = 0;
-    std::uint64_t n_ = 1;          // cells per axis at level_
-    bool table_ = false;           // n_ <= grid_table_limit: the level's cells in grid_
-    ir::CellGrid grid_;            // the level's cells per axis (when table_)
-    std::vector<Interval> points_; // ... computed from its grid points
-    std::vector<Interval> width_;  // enclosure of the root's width per axis
-    Batch batches_[2];             // one filling, the other maybe evaluating
+    std::uint64_t n_ = 1;              // cells per axis at level_
+    bool table_ = false;               // n_ <= grid_table_limit: the level's cells in grid_
+    ir::CellGrid grid_;                // the level's cells per axis (when table_)
+    std::vector<Interval> points_;     // ... computed from its grid points
+    std::vector<Interval> width_;      // enclosure of the root's width per axis
+    Batch batches_[batches_in_flight]; // one filling, the others maybe evaluating
     int filling_ = 0;
     std::vector<ChildBlock> blocks_; // the order of the level's cells (plan_children)
     std::uint64_t level_cells_ = 0;  // ... and their number
+    std::size_t kept_base_ = 0;      // where the level's cells start among the kept cells
     std::size_t min_cells_per_chunk_ = min_chunk;
     std::vector<LevelVariant> level_variants_;
     bool prune_in_chunks_ = false;                     // some of the level's cells prune in the chunks

@@ -17,10 +17,10 @@ void advise_huge_pages(const void* data, std::size_t bytes);
 
 // v.reserve(n) with the advice given before v's elements move into the new room (so that their copy
 // faults huge pages in as well).
-template <class T>
-void reserve_huge(std::vector<T>& v, std::size_t n) {
+template <class T, class Allocator>
+void reserve_huge(std::vector<T, Allocator>& v, std::size_t n) {
     if (n <= v.capacity()) return;
-    std::vector<T> room;
+    std::vector<T, Allocator> room;
     room.reserve(n);
     advise_huge_pages(room.data(), room.capacity() * sizeof(T));
     room.insert(room.end(), std::make_move_iterator(v.begin()), std::make_move_iterator(v.end()));
