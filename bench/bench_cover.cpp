@@ -1,8 +1,11 @@
 // What a JIT cover costs beyond evaluation, and how it scales to two threads (issue 13): the carpet's
 // RSS cover against the JIT's kernel alone on the same cells (boxes in memory, eval_boxes; and the
 // cells' coordinates with their level's grid, eval_cells), and a deep cover on 1 and 2 threads, also
-// keeping its cells (as `frac render` does: RssResult::cells).
-// Every variant in this one run, repetitions interleaved, medians.
+// keeping its cells (as `frac render` does: RssResult::cells), with the page faults each took (all
+// threads; the machine's cost of a fault decides what they are worth). Every variant in this one run,
+// repetitions interleaved, medians; a speed-up is given as the ratio of medians and as the median of
+// each repetition's ratio (a run and its two-thread run follow each other, so a machine whose speed
+// drifts over seconds shifts both alike).
 //
 //   bench_cover [depth=10] [deep_depth=12] [reps=5]
 #include "backend/llvm/jit.hpp"
@@ -15,6 +18,7 @@
 #include <cstdio>
 #include <fmt/format.h>
 #include <iostream>
+#include <sys/resource.h>
 
 using namespace frac;
 
@@ -25,6 +29,12 @@ double median(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
+long minor_faults() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return u.ru_minflt;
+}
+
 rt::RssResult cover(ir::Evaluator& e, const std::vector<ir::Interval>& box, int depth, int threads,
                     bool keep_cells = false) {
     rt::RssOptions o;
@@ -32,6 +42,31 @@ rt::RssResult cover(ir::Evaluator& e, const std::vector<ir::Interval>& box, int 
     o.threads = threads;
     o.keep_cells = keep_cells;
     return rt::subdivide(e, box, o);
+}
+
+// A deep cover's time and page faults, per repetition.
+struct Deep {
+    std::vector<double> seconds;
+    std::vector<double> faults;
+    std::uint64_t run(ir::Evaluator& e, const std::vector<ir::Interval>& box, int depth, int threads,
+                      bool keep_cells) { // returns the cells evaluated
+        const long f0 = minor_faults();
+        const rt::RssResult r = cover(e, box, depth, threads, keep_cells);
+        faults.push_back(static_cast<double>(minor_faults() - f0));
+        seconds.push_back(r.seconds);
+        return r.evaluated;
+    }
+};
+
+// "1 thread 0.300 s (120 faults), 2 threads 0.160 s (130 faults), speed-up 1.88x (median of ratios 1.90x)"
+std::string scaling(const Deep& one, const Deep& two) {
+    std::vector<double> ratios;
+    for (std::size_t r = 0; r < one.seconds.size(); ++r) ratios.push_back(one.seconds[r] / two.seconds[r]);
+    const double t1 = median(one.seconds), t2 = median(two.seconds);
+    return fmt::format(
+        "1 thread {:.3f} s ({:.0f} faults), 2 threads {:.3f} s ({:.0f} faults), speed-up {:.2f}x "
+        "(median of ratios {:.2f}x)",
+        t1, median(one.faults), t2, median(two.faults), t1 / t2, median(ratios));
 }
 
 } // namespace
@@ -69,7 +104,8 @@ int main(int argc, char** argv) {
         coords[cell.level].insert(coords[cell.level].end(), {cell.ix, cell.iy, 0, 0});
     std::vector<ir::CellVerdict> verdicts(n);
 
-    std::vector<double> kernel, cell_kernel, one, two, deep_one, deep_two, kept_one, kept_two;
+    std::vector<double> kernel, cell_kernel, one, two;
+    Deep deep_one, deep_two, kept_one, kept_two;
     std::uint64_t deep_cells = 0;
     for (int r = 0; r < reps; ++r) {
         auto t0 = bench::Clock::now();
@@ -84,12 +120,10 @@ int main(int argc, char** argv) {
         cell_kernel.push_back(bench::seconds_since(t0));
         one.push_back(cover(*jt, s.box, depth, 1).seconds);
         two.push_back(cover(*jt, s.box, depth, 2).seconds);
-        const rt::RssResult d1 = cover(*jt, s.box, deep, 1);
-        deep_one.push_back(d1.seconds);
-        deep_two.push_back(cover(*jt, s.box, deep, 2).seconds);
-        kept_one.push_back(cover(*jt, s.box, deep, 1, true).seconds);
-        kept_two.push_back(cover(*jt, s.box, deep, 2, true).seconds);
-        deep_cells = d1.evaluated;
+        deep_cells = deep_one.run(*jt, s.box, deep, 1, false);
+        deep_two.run(*jt, s.box, deep, 2, false);
+        kept_one.run(*jt, s.box, deep, 1, true);
+        kept_two.run(*jt, s.box, deep, 2, true);
     }
     const double ns = 1e9 / double(n);
     const double k = median(kernel) * ns, c1 = median(one) * ns, c2 = median(two) * ns;
@@ -101,13 +135,9 @@ int main(int argc, char** argv) {
         "  cover, 1 thread                              {:8.1f}   beyond the kernel {:6.1f} ({:.0f} %)\n", c1,
         c1 - k, 100 * (c1 - k) / c1);
     fmt::print("  cover, 2 threads                             {:8.1f}   speed-up {:.2f}x\n", c2, c1 / c2);
-    const double t1 = median(deep_one), t2 = median(deep_two);
-    fmt::print("JIT carpet cover, depth {} ({} evaluations): 1 thread {:.3f} s, 2 threads {:.3f} s, speed-up "
-               "{:.2f}x\n",
-               deep, deep_cells, t1, t2, t1 / t2);
-    const double k1 = median(kept_one), k2 = median(kept_two);
-    fmt::print("  keeping its cells: 1 thread {:.3f} s, 2 threads {:.3f} s, speed-up {:.2f}x\n", k1, k2,
-               k1 / k2);
+    fmt::print("JIT carpet cover, depth {} ({} evaluations)\n  {}\n", deep, deep_cells,
+               scaling(deep_one, deep_two));
+    fmt::print("  keeping its cells: {}\n", scaling(kept_one, kept_two));
     double load[3] = {0, 0, 0};
     if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
         if (std::fscanf(f, "%lf %lf %lf", &load[0], &load[1], &load[2]) != 3) load[0] = -1;
