@@ -43,12 +43,13 @@ inline constexpr ir::PruneCosts interp_prune_costs{.eval_ns_per_cost = tape_eval
                                                    .compile_ns_per_instruction = 0.0,
                                                    .eval_ns_fixed = cover_eval_ns_fixed};
 
-// Recording the choices over a box and building the pruned tape cost about as much as the 4
-// children of a 2D cell one level above the depth could save (bench/bench_large: 3.3 µs per
-// evaluation when those cells prune too, 2.3 µs without, on a 1000-clause model): the interpreter
-// prunes for cells with at least this many expected descendant evaluations (2D: 2 levels above the
-// depth; 3D: 1).
-inline constexpr double interp_min_expected_evaluations = 8;
+// Recording the choices over a box and building the pruned tape (its memory, fresh, faulted in;
+// and a variant of the cover) cost more than the 12 expected descendants of a 2D cell two levels
+// above the depth save (bench/bench_large quick, one thread, the Zen 5 VM: 1000, 3000 and 7000
+// clauses 698, 926, 1258 ns per evaluation pushing there, 572, 795, 1124 not; one level above, 4
+// descendants: 3.3 against 2.3 µs on 1000 clauses): the interpreter prunes for cells with more than
+// this many expected descendant evaluations (2D: 3 levels above the depth, 28; 3D: 2, 40).
+inline constexpr double interp_min_expected_evaluations = 16;
 
 // Records the min/max/select choices of a tape over boxes with the interpreter (ir/specialize.hpp):
 // how engines without a register file of their own (the JIT) learn what to prune.

@@ -164,7 +164,7 @@ TEST_CASE("flat tape pushes compute what ir::specialize's tapes compute, from an
                 const std::vector<Interval>& box = boxes[k];
                 // Boxes of one batch push for different expected evaluations now and then (the most a
                 // pruned tape may cost differs; the batch's analysis must follow).
-                const double evaluations[] = {1e12, 40, 12};
+                const double evaluations[] = {1e12, 40, 20};
                 const double expected_evaluations = evaluations[(k + static_cast<std::size_t>(trial)) % 3];
                 auto push = flat->specialize_after_eval(k, box.data(), expected_evaluations);
                 const std::vector<ir::Choice> choices = recorder.record(box.data());

@@ -471,8 +471,9 @@ TEST_CASE("a large model's tapes shrink down the tree, and its cover stays the s
     const rt::RssResult b = rt::subdivide(*pruning, s.box, o);
     CHECK(rt::same_cover(a, b));
     // Every level with children asks to prune, and the functions shrink down the tree (each cell's is
-    // its parent's or a pruned one of it; the mix of cells changes from level to level): at the depth a
-    // cell evaluates a small part of the model.
+    // its parent's or a pruned one of it; the mix of cells changes from level to level) to the last
+    // level whose cells prune (in 2D 3 levels above the depth: interp_min_expected_evaluations): at the
+    // depth a cell evaluates a small part of the model.
     const auto mean = [&](int k) {
         const auto level = static_cast<std::size_t>(k);
         return b.prune_levels[level].instructions / static_cast<double>(b.levels[level].evaluated);
@@ -482,8 +483,8 @@ TEST_CASE("a large model's tapes shrink down the tree, and its cover stays the s
     INFO("instructions per evaluation: " << mean(2) << " at level 2, " << mean(5) << " at 5, "
                                          << mean(o.depth) << " at the depth, " << full << " unpruned");
     CHECK(mean(5) < 0.5 * mean(2));
-    CHECK(mean(o.depth) < 0.5 * mean(5));
-    CHECK(mean(o.depth) < 0.02 * full);
+    CHECK(mean(o.depth) < mean(5));
+    CHECK(mean(o.depth) < 0.04 * full);
     CHECK(b.prune_levels[static_cast<std::size_t>(o.depth)].requests == 0); // no children to prune for
     CHECK(pruning->specialize_stats.requests ==
           pruning->specialize_stats.unpruned + pruning->specialize_stats.too_little +
