@@ -158,6 +158,7 @@ struct KeptBuffers {
     std::vector<Pos> cells[batches_in_flight];
     std::vector<CellVerdict> verdicts[batches_in_flight];
     std::vector<std::uint32_t> undecided[batches_in_flight];
+    std::vector<std::uint32_t> rows[batches_in_flight];
 };
 constexpr std::size_t kept_buffer_bytes = std::size_t{16} << 20;
 
@@ -208,6 +209,7 @@ public:
             take_buffer(batches_[i].cells, k.cells[i]);
             take_buffer(batches_[i].verdicts, k.verdicts[i]);
             take_buffer(batches_[i].undecided, k.undecided[i]);
+            take_buffer(batches_[i].rows, k.rows[i]);
         }
     }
 
@@ -228,6 +230,7 @@ public:
             leave_buffer(k.cells[i], batches_[i].cells);
             leave_buffer(k.verdicts[i], batches_[i].verdicts);
             leave_buffer(k.undecided[i], batches_[i].undecided);
+            leave_buffer(k.rows[i], batches_[i].rows);
         }
     }
 
