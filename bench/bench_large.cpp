@@ -14,7 +14,8 @@
 // time: the machine is shared), the compile time, the wall time (compile + cover) and whether the
 // cover is the reference one; per level, for the pruned
 // interpreter, the cells, the prune requests, the pruned functions made and the mean instructions
-// per evaluation. Writes the models (for `frac render`) and JSON.
+// per evaluation. Writes the models (for `frac render`) and JSON. Runs on the frac command's
+// allocator (cli/allocator.hpp), as the command does.
 //
 //   bench_large [depth=10] [json=bench_large.json] [model_dir=.] [sizes=1000,3000,7000] [jit=1]
 //               [quick|pushes]
@@ -25,6 +26,7 @@
 #include "backend/llvm/jit.hpp"
 #include "bench/bench_common.hpp"
 #include "bench/large_models.hpp"
+#include "cli/allocator.hpp"
 #include "driver/pipeline.hpp"
 #include "runtime/rss.hpp"
 
@@ -34,6 +36,7 @@
 #include <iostream>
 #include <random>
 #include <sstream>
+#include <thread>
 
 using namespace frac;
 
@@ -167,9 +170,7 @@ std::vector<int> parse_sizes(const std::string& s) {
     return sizes;
 }
 
-} // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
     const int depth = argc > 1 ? std::atoi(argv[1]) : 10;
     const std::string json_path = argc > 2 ? argv[2] : "bench_large.json";
     const std::string model_dir = argc > 3 ? argv[3] : ".";
@@ -177,6 +178,7 @@ int main(int argc, char** argv) {
     const bool with_jit = argc > 5 ? std::atoi(argv[5]) != 0 : true;
     const std::string mode = argc > 6 ? argv[6] : "";
     const bool quick = mode == "quick" || mode == "pushes";
+    fmt::print("allocator: {}\n", cli::allocator_in_use());
     std::string why;
     if (with_jit && !jit::jit_available(&why)) {
         std::cerr << "bench_large: the JIT is not available: " << why << "\n";
@@ -296,4 +298,17 @@ int main(int argc, char** argv) {
     std::ofstream(json_path) << json;
     fmt::print("\nwrote {}\n", json_path);
     return 0;
+}
+
+} // namespace
+
+// The frac command's allocator, tuned as the command tunes it, and the work on a thread of its own as
+// in the command: the main thread's heap began before the tuning (a large model's cover allocates
+// hundreds of megabytes of pushed tapes; on 4 KB pages their faults were a third of the cover on a VM).
+int main(int argc, char** argv) {
+    cli::tune_allocator();
+    int status = 1;
+    std::thread work([&] { status = run(argc, argv); });
+    work.join();
+    return status;
 }

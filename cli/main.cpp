@@ -1,4 +1,5 @@
 // frac: the command-line tool. Thin: it wires the frontend, the engines and the runtime together.
+#include "cli/allocator.hpp"
 #include "cli/commands.hpp"
 #include "cli/fit_curve.hpp"
 #include "frontend/suggest.hpp"
@@ -51,6 +52,7 @@ int finish(int status) {
 } // namespace
 
 int main(int argc, char** argv) {
+    frac::cli::tune_allocator();            // before the work thread and its heap
     frac::driver::leave_compiles_at_exit(); // finish() below
     // Worker threads get a large stack too, whatever parallel work starts them first
     // (rt::worker_stack_bytes).
