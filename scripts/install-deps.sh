@@ -4,7 +4,7 @@ set -euo pipefail
 packages=(build-essential cmake pkg-config libfmt-dev catch2 libcli11-dev libeigen3-dev libgmp-dev
           libpng-dev libmpfr-dev libmpfi-dev libtbb-dev llvm-19-dev libllvmlibc-19-dev clang-format
           libosd-dev libceres-dev libjpeg62-turbo-dev xplanet-images zlib1g-dev python-matplotlib-data
-          libmimalloc-dev)
+          libmimalloc-dev libzstd-dev)
 # --fuzz: also clang-19 and its libFuzzer run time, for `make fuzz` only (the build uses the default compiler).
 if [ "${1:-}" = "--fuzz" ]; then packages+=(clang-19 libclang-rt-19-dev); fi
 missing=()
