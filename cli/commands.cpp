@@ -38,6 +38,7 @@ int run_check(const std::string& file, const std::string& emit, const std::strin
     auto c = compile_or_report(file, stage ? std::min(*stage, driver::Stage::lower) : driver::Stage::lower,
                                timing);
     if (!c) return front::exit_compile_error;
+    const FreedAtExit keep_model(c);
     std::vector<std::string> shapes;
     if (!shape.empty()) shapes.push_back(find_shape(*c, shape).name);
     try {
@@ -85,6 +86,7 @@ int run_eval(const std::string& file, const std::string& shape, const std::strin
              const EngineOptions& engine) {
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
+    const FreedAtExit keep_model(c);
     const front::ShapeInfo& s = find_shape(*c, shape);
     auto eval = make_evaluator(c->module, s.root, s.dimension, engine);
     if (at.empty() && box.empty()) throw UsageError("give --at x,y or --box x0:x1,y0:y1");
@@ -289,6 +291,7 @@ int run_dimension(const std::string& file, const std::string& shape, int from, i
                   const WorkLimits& limits, const EngineOptions& engine) {
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
+    const FreedAtExit keep_model(c);
     if (const front::AutomatonInfo* a = c->module.find_automaton(shape))
         return automaton_dimension(*a, from, to);
     const front::ShapeInfo& s = pick_shape(*c, shape);
