@@ -1,40 +1,15 @@
 // The frac command's allocator (cli/allocator.cpp): tuned, a fresh thread's large allocations lie in
 // memory advised for huge pages.
 #include "cli/allocator.hpp"
+#include "tests/unit/vm_flags.hpp"
 
 #include <catch2/catch.hpp>
-#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <thread>
-
-namespace {
-
-// The VmFlags of the mapping of /proc/self/smaps that holds `address` ("" if none does).
-std::string mapping_flags(const void* address) {
-    const auto at = reinterpret_cast<std::uintptr_t>(address);
-    std::ifstream smaps("/proc/self/smaps");
-    bool inside = false;
-    for (std::string line; std::getline(smaps, line);) {
-        std::uintptr_t begin = 0, end = 0;
-        char dash = 0;
-        std::istringstream range(line);
-        if (range >> std::hex >> begin >> dash >> end && dash == '-' && line.find(' ') != std::string::npos &&
-            line.find(':') > line.find(' ')) {
-            inside = begin <= at && at < end;
-            continue;
-        }
-        if (inside && line.rfind("VmFlags:", 0) == 0) return line;
-    }
-    return "";
-}
-
-} // namespace
 
 TEST_CASE("the tuned allocator gives a fresh thread huge-page memory") {
 #if defined(FRAC_MIMALLOC)
@@ -50,7 +25,7 @@ TEST_CASE("the tuned allocator gives a fresh thread huge-page memory") {
             constexpr std::size_t bytes = std::size_t{64} << 20;
             std::unique_ptr<char[]> block(new char[bytes]);
             std::memset(block.get(), 1, bytes);
-            flags = mapping_flags(block.get() + bytes / 2);
+            flags = frac::test::vm_flags_at(block.get() + bytes / 2);
         }).join();
         return flags;
     };
