@@ -174,8 +174,10 @@ Value* BoxGen::is_finite(Value* x) {
 
 SlotState BoxGen::op_mod1(const SlotState& a) {
     Value* f = floor(a.v.lo);
-    Value* whole = b_.CreateOr(lnot(land(is_finite(a.v.lo), is_finite(a.v.hi))),
-                               cmp(llvm::CmpInst::FCMP_UNE, floor(a.v.hi), f));
+    // The core's test (an end infinite, or floor hi != floor lo) with one rounding: !(hi < RU(f + 1)).
+    // f + 1 is exact below 2^53 and the next double above f beyond it; an infinite end makes the
+    // comparison false.
+    Value* whole = lnot(lt(a.v.hi, add(f, cst(1.0))));
     const IV r{sel(whole, cst(0.0), sub_down(a.v.lo, f)), sel(whole, cst(1.0), sub(a.v.hi, f))};
     return result(guard(empty_of(a), r, a.v), a.f.maybe_empty);
 }
@@ -183,27 +185,28 @@ SlotState BoxGen::op_mod1(const SlotState& a) {
 SlotState BoxGen::op_dz(const SlotState& a) {
     Value* lo = a.v.lo;
     Value* hi = a.v.hi;
-    Value* whole = lnot(lt(sub(hi, lo), cst(1.0))); // !(hi - lo < 1): a whole period
-    Value* fl = floor(lo);
+    // Two roundings instead of four and no test for a whole period, the interpreter's bits
+    // (numeric::dz) all the same: when hi - lo >= 1 (rounded upward) the bounds below are 0 (an integer
+    // lies in the box) and 1/2 (hi - k >= 1/2); where an end is infinite ceil lo <= hi holds and a
+    // difference is infinite or NaN, and the comparison in std_min(1/2, NaN) is false: 1/2.
     Value* cl = ceil(lo);
-    Value* ch = ceil(hi);
-    // dz_down(x) = min(sub_down(x, floor x), sub_down(ceil x, x)); dz_up(x) = min(x - floor x, ceil x -
-    // x). The lower bound min(dz_down(lo), dz_down(hi)) counts only when no integer lies in [lo, hi]:
-    // then floor hi = floor lo, ceil lo = ceil hi, and of the four differences, all positive, the
-    // least is at lo - floor lo or ceil hi - hi (RD is monotone; equal positive doubles have equal bits).
-    Value* rlo = std_min(sub_down(lo, fl), sub_down(ch, hi));
+    Value* k = round_even(lo);
+    // dz_down(x) = min(sub_down(x, floor x), sub_down(ceil x, x)). The lower bound min(dz_down(lo),
+    // dz_down(hi)) counts only when no integer lies in [lo, hi]: then lo is not an integer, floor lo =
+    // ceil lo - 1 (exact below 2^53, where every double is an integer), ceil hi = ceil lo, and of the
+    // four differences, all positive, the least is at lo - floor lo or ceil hi - hi (RD is monotone;
+    // equal positive doubles have equal bits).
+    Value* rlo = std_min(sub_down(lo, sub(cl, cst(1.0))), sub_down(cl, hi));
+    rlo = sel(le(cl, hi), cst(0.0), rlo);
     // The upper bound max(dz_up(lo), dz_up(hi)) counts only when no half-integer lies in [lo, hi]: then
     // both ends are nearer to one integer k than to any other (neither is a half-integer), dz_up(x) is
     // RU(|x - k|) (the nearer difference; RU is monotone), and the larger of the two is RU(k - lo) or
-    // RU(hi - k), whichever is not negative (both +0 when lo = hi = k, as dz_up gives).
-    Value* k = round_even(lo);
-    Value* rhi = std_max(sub(k, lo), sub(hi, k));
-    rlo = sel(le(cl, hi), cst(0.0), rlo);
-    Value* half = add(fl, cst(0.5));
-    half = sel(lt(half, lo), add(half, cst(1.0)), half);
-    rhi = sel(le(half, hi), cst(0.5), rhi);
-    const IV r{sel(whole, cst(0.0), rlo), sel(whole, cst(0.5), rhi)};
-    return result(guard(empty_of(a), r, a.v), a.f.maybe_empty);
+    // RU(hi - k), whichever is not negative (both +0 when lo = hi = k, as dz_up gives). With k nearest
+    // to lo and hi - lo < 1, a half-integer lies in [lo, hi] exactly when lo = k - 1/2 or hi >= k + 1/2,
+    // and both differences, within 3/2 of an integer, are exact: then one of them is at least 1/2 and
+    // the bound is 1/2, otherwise both are below it.
+    Value* rhi = std_min(cst(0.5), std_max(sub(k, lo), sub(hi, k)));
+    return result(guard(empty_of(a), IV{rlo, rhi}, a.v), a.f.maybe_empty);
 }
 
 SlotState BoxGen::op_not(const SlotState& a) {

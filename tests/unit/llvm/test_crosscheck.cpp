@@ -220,3 +220,47 @@ TEST_CASE("closed expressions (no coordinates) agree", "[llvm][crosscheck]") {
     CHECK(same(in->eval_box(nullptr), jt->eval_box(nullptr)));
     CHECK(same(in->eval_point(nullptr), jt->eval_point(nullptr)));
 }
+
+TEST_CASE("dz floor ceil and mod agree on boxes ending at their breakpoints", "[llvm][crosscheck]") {
+    // Every box whose ends are integers, half-integers, thirds and quarters, their neighbouring doubles,
+    // at small and large magnitudes (past 2^52 every double is an integer): the JIT's shortcuts for dz
+    // (its bounds from ceil lo and the integer nearest lo) must give the core's bits at each corner case.
+    std::vector<double> ends = {-0.0, 1e-310, -1e-310, num::inf, -num::inf};
+    for (double k : {-3.0, -1.0, 0.0, 1.0, 2.0, 0x1p52 - 1, 0x1p52, 0x1p53, 1e17, -1e300})
+        for (double f : {0.0, 0.5, -0.5, 1.0 / 3, 0.25, 0.75, 0.999999}) {
+            const double v = k + f;
+            ends.insert(ends.end(), {v, std::nextafter(v, num::inf), std::nextafter(v, -num::inf)});
+        }
+    std::vector<Interval> boxes;
+    for (double lo : ends)
+        for (double hi : ends)
+            if (lo <= hi && lo != num::inf && hi != -num::inf)
+                boxes.insert(boxes.end(), {{lo, hi}, {0.0, 0.0}});
+    // And boxes a little narrower or wider than a period, anywhere, whose width rounds in every way.
+    BoxMaker mk(31337);
+    for (int n = 0; n < 20000; ++n) {
+        const double lo = mk.pick(9) - 4 + std::ldexp(mk.uniform(-1, 1), -mk.pick(60));
+        const double w = 1 + (mk.pick(2) ? 1 : -1) * std::ldexp(1.0, -mk.pick(64));
+        boxes.insert(boxes.end(), {{lo, lo + w}, {0.0, 0.0}});
+    }
+    for (const char* e : {"dz(x)", "floor(x) + ceil(x)", "mod(x, 1)", "dz(x) - dz(x + 0.5)"}) {
+        const Model m = compile(std::string("shape s(x, y) = y + ") + e + ";");
+        auto in = interp::make_interpreter(m.tapes[0]);
+        const std::size_t count = boxes.size() / 2;
+        std::vector<Interval> expected(count);
+        in->eval_boxes(boxes.data(), count, expected.data());
+        for (const jit::JitConfig& config : jit_configs()) {
+            auto jt = jit::make_jit(m.tapes[0], {}, config);
+            std::vector<Interval> got(count);
+            jt->eval_boxes(boxes.data(), count, got.data());
+            std::size_t mismatches = 0;
+            std::string first;
+            for (std::size_t n = 0; n < count; ++n)
+                if (!same(expected[n], got[n]) && mismatches++ == 0)
+                    first =
+                        hex_box(&boxes[2 * n], 2) + ": interp " + hex(expected[n]) + ", jit " + hex(got[n]);
+            INFO(e << ", " << describe(config) << ": " << first);
+            CHECK(mismatches == 0);
+        }
+    }
+}
