@@ -269,8 +269,14 @@ SlotState BoxGen::emit_series(const Instr& ins) {
     llvm::PHINode* acc_hi = b_.CreatePHI(vt_, 2, "acc.hi");
     llvm::PHINode* active = b_.CreatePHI(mt_, 2, "active");
     llvm::PHINode* stop_at = b_.CreatePHI(vi64_, 2, "stop.at"); // the index after which a lane stopped
-    acc_lo->addIncoming(cst(0.0), pre);
-    acc_hi->addIncoming(cst(0.0), pre);
+    // A min or max series starts from its identity, [+inf, +inf] or [-inf, -inf] (never empty, and
+    // NaN is never a bound): combined with the first term it gives that term's bits, empty or not,
+    // with no test for the first index in the loop. A sum starts from 0 and takes its first term as is
+    // (0 + -0 would be +0).
+    const bool from_identity = s.kind != Op::SeriesSum;
+    const double identity = s.kind == Op::SeriesMin ? inf : -inf;
+    acc_lo->addIncoming(cst(from_identity ? identity : 0.0), pre);
+    acc_hi->addIncoming(cst(from_identity ? identity : 0.0), pre);
     active->addIncoming(outer_mask, pre);
     stop_at->addIncoming(splat(L.start_v), pre);
     const bool escape = infinite && s.data.escape.present;
@@ -298,10 +304,13 @@ SlotState BoxGen::emit_series(const Instr& ins) {
         std::tie(esc_now, esc_far) = escape_bound(s, next_state, b_.CreateAdd(i, b_.getInt64(1)), active);
     const SlotState acc = result({acc_lo, acc_hi}, term.f.maybe_empty);
     const SlotState comb = combine(s.kind, acc, term);
-    Value* first = splat(L.first);
+    SlotState nacc = comb;
+    if (!from_identity) {
+        Value* first = splat(L.first);
+        nacc =
+            result({sel(first, term.v.lo, comb.v.lo), sel(first, term.v.hi, comb.v.hi)}, term.f.maybe_empty);
+    }
     // Lanes that stopped keep their partial result.
-    SlotState nacc =
-        result({sel(first, term.v.lo, comb.v.lo), sel(first, term.v.hi, comb.v.hi)}, term.f.maybe_empty);
     if (w_ > 1) nacc.v = {sel(active, nacc.v.lo, acc_lo), sel(active, nacc.v.hi, acc_hi)};
     bump(terms_, count(active));
     Value* is_last = L.is_last;
