@@ -212,7 +212,7 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
         throw UsageError(
             fmt::format("--ascii needs COLSxROWS such as 64x32 (1 to 1000 each), not '{}'", o.ascii));
     if (o.size < 16 || o.size > 8192) throw UsageError("--size must be between 16 and 8192 pixels");
-    if (!o.output.empty()) check_output_writable(o.output);
+    if (!o.output.empty()) check_output_writable(o.output, {file});
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
     const FreedAtExit keep_model(c);
@@ -323,7 +323,7 @@ int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions&
         selection = rt::MeshSelection::boundary;
     else if (o.select != "inside")
         throw UsageError(fmt::format("unknown selection '{}': use inside, cover or boundary", o.select));
-    check_output_writable(o.output);
+    check_output_writable(o.output, {file});
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
     const FreedAtExit keep_model(c);

@@ -62,9 +62,18 @@ int run_compile(const std::string& file, const CompileOptions& o) {
     const std::string ir_path = ir_only       ? o.output
                                 : o.emit_llvm ? fs::path(o.output).replace_extension(".ll").string()
                                               : std::string();
-    // Every output is written atomically (support/atomic_file.hpp) and checked before any work.
-    for (const std::string& path : {o.output, ir_path, o.header})
-        if (!path.empty()) check_output_writable(path);
+    // Every output is written atomically (support/atomic_file.hpp) and checked before any work: none may
+    // be the model or another output.
+    std::vector<std::string> taken;
+    for (const std::string& path : {o.output, ir_only ? std::string() : ir_path, o.header}) {
+        if (path.empty()) continue;
+        check_output_writable(path, {file});
+        for (const std::string& other : taken)
+            if (support::same_file(path, other))
+                throw UsageError(fmt::format("'{}' is the file of two outputs ('{}' too): give each its own",
+                                             path, other));
+        taken.push_back(path);
+    }
     jit::AotConfig config;
     config.options.max_terms = o.max_terms;
     config.cpu = o.cpu;

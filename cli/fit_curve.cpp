@@ -113,7 +113,7 @@ int run_fit_curve(const FitCurveOptions& o) {
     if (o.quantize != 0 && o.quantize != 8)
         throw UsageError(
             fmt::format("--quantize {}: curve fits store parameters in 8 bits or in full", o.quantize));
-    if (!o.output.empty()) check_output_writable(o.output);
+    if (!o.output.empty()) check_output_writable(o.output, {o.file});
     const auto kind = o.kind == "function" ? rt::fit::DataKind::function
                       : o.kind == "curve"  ? rt::fit::DataKind::curve
                                            : rt::fit::DataKind::automatic;

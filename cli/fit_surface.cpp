@@ -92,8 +92,7 @@ std::size_t parse_patches(const std::string& text) {
 int run_fit_surface(const FitSurfaceOptions& o) {
     using namespace rt::fit;
     const std::size_t split = parse_patches(o.patches);
-    if (const std::string problem = support::output_problem(o.output); !problem.empty())
-        throw UsageError(fmt::format("cannot write '{}': {}", o.output, problem));
+    check_output_writable(o.output, {o.data});
     HeightGrid data;
     try {
         data = read_height_grid(o.data);

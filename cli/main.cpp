@@ -6,8 +6,10 @@
 #include "runtime/rss.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -42,8 +44,16 @@ struct Work {
 // running (the interpreter finished first): leave without waiting for it, and without tearing LLVM
 // down under it. Objects kept for the exit (cli::FreedAtExit) are freed by leaving the same way.
 int finish(int status) {
-    if (!frac::driver::background_compile_pending() && !frac::cli::objects_kept_for_exit()) return status;
+    // What was printed must have reached the standard output (a full disk, a closed pipe): a run whose
+    // output is lost does not succeed.
+    errno = 0;
     std::cout.flush();
+    if (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout) {
+        std::fprintf(stderr, "frac: error: cannot write the standard output: %s\n",
+                     errno != 0 ? std::strerror(errno) : "write error");
+        if (status == 0) status = 1;
+    }
+    if (!frac::driver::background_compile_pending() && !frac::cli::objects_kept_for_exit()) return status;
     std::cerr.flush();
     std::fflush(nullptr);
     std::_Exit(status);

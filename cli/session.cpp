@@ -200,9 +200,13 @@ bool ends_with(const std::string& s, const std::string& suffix) {
     return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-void check_output_writable(const std::string& path) {
+void check_output_writable(const std::string& path, const std::vector<std::string>& inputs) {
     if (std::string problem = support::output_problem(path); !problem.empty())
         throw UsageError(fmt::format("cannot write '{}': {}", path, problem));
+    for (const std::string& input : inputs)
+        if (support::same_file(path, input))
+            throw UsageError(
+                fmt::format("cannot write '{}': it would overwrite the input '{}'", path, input));
 }
 
 std::vector<ir::Interval> parse_box(const std::string& text, int dimension) {

@@ -60,8 +60,9 @@ bool ends_with(const std::string& s, const std::string& suffix);
 // naming the variable and `unit` when it is set to anything else.
 std::optional<double> positive_env(const char* name, const char* unit);
 
-// Throws UsageError when `path` cannot be written (checked before any work; leaves no file behind).
-void check_output_writable(const std::string& path);
+// Throws UsageError when `path` cannot be written (checked before any work; leaves no file behind), or
+// when it names the same file as one of `inputs` (the model, the data), which writing would destroy.
+void check_output_writable(const std::string& path, const std::vector<std::string>& inputs = {});
 
 // Throws the UsageError for an unknown name, with the nearest known one and the list.
 [[noreturn]] void no_such_name(const std::string& what, const std::string& name,

@@ -33,6 +33,12 @@ fs::path directory_of(const fs::path& target) {
     return target.parent_path().empty() ? fs::path(".") : target.parent_path();
 }
 
+// Whether `path` exists as something other than a regular file or a directory (following links).
+bool is_special(const std::string& path) {
+    struct stat st {};
+    return ::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode);
+}
+
 // A symbolic link is written through, as opening it for writing would.
 std::string resolved(const std::string& path) {
     std::error_code ec;
@@ -43,7 +49,15 @@ std::string resolved(const std::string& path) {
 
 } // namespace
 
-AtomicFile::AtomicFile(std::string path, std::string what) : path_(resolved(path)), what_(std::move(what)) {
+AtomicFile::AtomicFile(std::string path, std::string what) : what_(std::move(what)) {
+    if (is_special(path)) {
+        path_ = std::move(path);
+        direct_ = true;
+        fd_ = ::open(path_.c_str(), O_WRONLY | O_CLOEXEC);
+        if (fd_ < 0) fail(std::strerror(errno));
+        return;
+    }
+    path_ = resolved(path);
     remove_stale_temporaries(path_);
     const fs::path target(path_);
     if (target.filename().empty()) fail("not a file name");
@@ -113,6 +127,14 @@ std::FILE* AtomicFile::stream() {
 void AtomicFile::commit() {
     if (fd_ < 0) fail("already closed");
     if (stream_ && (std::fflush(stream_) != 0 || std::ferror(stream_))) fail(std::strerror(errno));
+    if (direct_) {
+        const int closed = stream_ ? std::fclose(stream_) : ::close(fd_);
+        const int close_errno = errno;
+        stream_ = nullptr;
+        fd_ = -1;
+        if (closed != 0) fail(std::strerror(close_errno));
+        return;
+    }
     if (named_temp_.empty()) {
         // Give the unnamed file a name beside the target (linkat through /proc needs no privilege), then
         // rename it over the target: the name exists for the span of two system calls.
@@ -177,6 +199,7 @@ void copy_file_atomically(const std::string& from, const std::string& path, cons
 }
 
 std::string output_problem(const std::string& path) {
+    if (is_special(path)) return ::access(path.c_str(), W_OK) == 0 ? "" : std::strerror(errno);
     const fs::path target(resolved(path));
     if (target.filename().empty()) return "not a file name";
     std::error_code ec;
@@ -193,6 +216,14 @@ std::string output_problem(const std::string& path) {
     if (fd < 0) return std::strerror(errno);
     ::close(fd);
     return "";
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+    std::error_code ec;
+    if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
+    const fs::path pa = fs::weakly_canonical(fs::absolute(a, ec), ec),
+                   pb = fs::weakly_canonical(fs::absolute(b, ec), ec);
+    return pa == pb;
 }
 
 void remove_stale_temporaries(const std::string& path) {

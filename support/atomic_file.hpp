@@ -3,6 +3,8 @@
 // target: a run that fails, is killed or fills the disk leaves the previous file as it was and no partial
 // one. A named temporary is handed to the process's cleaner (support/process_cleaner.hpp) before it exists,
 // so that a kill at any moment leaves nothing beside the target once the process is gone.
+// A target that exists and is neither a regular file nor a directory (a device such as /dev/null, a FIFO,
+// a terminal, /dev/stdout) is written straight through instead: renaming over it would replace it.
 // Used by every writer of user-visible outputs (pictures, meshes, compiled models, headers).
 #pragma once
 
@@ -36,6 +38,7 @@ private:
     void discard() noexcept;
     std::string path_, what_;
     std::string named_temp_; // the temporary's name when it has one (no O_TMPFILE)
+    bool direct_ = false;    // writing to the target itself (not a regular file)
     int fd_ = -1;
     std::FILE* stream_ = nullptr;
 };
@@ -48,6 +51,10 @@ void copy_file_atomically(const std::string& from, const std::string& path, cons
 // Checks, before any work, that `path` can be written: its directory exists and takes new files, and
 // it is not a directory. Returns the reason it cannot, or "" when it can. Creates nothing.
 std::string output_problem(const std::string& path);
+
+// Whether `a` and `b` name one file: the same existing file (through links too), or the same path once
+// made absolute and normal when either does not exist yet.
+bool same_file(const std::string& a, const std::string& b);
 
 // Removes the temporaries that runs killed before they could (those of processes no longer alive)
 // beside `path`. AtomicFile calls it; exposed for tests.

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <sys/stat.h>
+#include <thread>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
@@ -109,4 +110,32 @@ TEST_CASE("temporaries of dead writers are removed, those of live ones kept", "[
     CHECK(fs::exists(live));
     CHECK(fs::exists(other)); // another output's: its own writer sweeps it
     fs::remove_all(dir);
+}
+
+TEST_CASE("a target that is not a regular file is written through and stays what it was", "[support]") {
+    // A FIFO (as a device or /dev/stdout would be): renaming over it would replace it with a file.
+    const fs::path dir = scratch("fifo");
+    const fs::path fifo = dir / "out.png";
+    REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+    CHECK(output_problem(fifo.string()).empty());
+    std::string received;
+    std::thread reader([&] { received = read(fifo); });
+    write_file_atomically(fifo.string(), "picture bytes", "PNG");
+    reader.join();
+    CHECK(received == "picture bytes");
+    CHECK(fs::is_fifo(fifo));
+    CHECK(entries(dir) == 1);
+}
+
+TEST_CASE("same_file knows a file under its other names and a path not written yet", "[support]") {
+    const fs::path dir = scratch("same");
+    std::ofstream(dir / "model.frac") << "shape s(x, y) = x;";
+    fs::create_hard_link(dir / "model.frac", dir / "linked.frac");
+    fs::create_symlink(dir / "model.frac", dir / "symlinked.frac");
+    CHECK(same_file((dir / "model.frac").string(), (dir / "linked.frac").string()));
+    CHECK(same_file((dir / "symlinked.frac").string(), (dir / "model.frac").string()));
+    CHECK(same_file((dir / "sub/../model.frac").string(), (dir / "model.frac").string()));
+    CHECK(same_file((dir / "new.o").string(), (dir / "." / "new.o").string()));
+    CHECK_FALSE(same_file((dir / "model.frac").string(), (dir / "new.o").string()));
+    CHECK_FALSE(same_file((dir / "a.h").string(), (dir / "a.o").string()));
 }
