@@ -235,7 +235,20 @@ private:
         info.loc = it.loc;
         // The type checker checked the box and the dimension.
         info.dimension = typed_.items.at(&it).size;
-        if (it.over) info.box = closed(*it.over, Context::constant, true).box;
+        if (it.over) {
+            info.box = closed(*it.over, Context::constant, true).box;
+            for (std::size_t a = 0; a < info.box.size(); ++a) {
+                // Covers split the box from its width: it must be a real interval the doubles can span.
+                const Interval x = info.box[a];
+                if (!(std::isfinite(x.lo) && std::isfinite(x.hi) && x.lo < x.hi &&
+                      std::isfinite(x.hi - x.lo)))
+                    fail(
+                        it.over->loc,
+                        fmt::format("axis {} of the box of shape '{}' is [{}, {}]: a box needs finite bounds "
+                                    "with lo < hi, and a width below the largest double",
+                                    a + 1, it.name, x.lo, x.hi));
+            }
+        }
         if (info.box.empty()) info.box.assign(static_cast<std::size_t>(info.dimension), Interval{0.0, 1.0});
         std::vector<Value> coords;
         for (int k = 0; k < info.dimension; ++k) coords.push_back(Value::scalar(g_.var(k)));

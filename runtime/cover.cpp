@@ -1,6 +1,7 @@
 #include "runtime/cover.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <fmt/format.h>
 #include <stdexcept>
 
@@ -15,8 +16,10 @@ std::uint64_t ipow(int split, int k) {
 }
 
 Interval point(Interval axis, Interval w, std::uint64_t j, std::uint64_t n) {
-    const Interval t =
-        num::div(num::mul(w, Interval(static_cast<double>(j))), Interval(static_cast<double>(n)));
+    const Interval jd(static_cast<double>(j)), nd(static_cast<double>(n));
+    Interval t = num::div(num::mul(w, jd), nd);
+    // Past the largest double w * j overflows (a box wider than about 1e308 / n): divide first.
+    if (!std::isfinite(t.hi)) t = num::mul(num::div(w, nd), jd);
     return num::add(Interval(axis.lo), t);
 }
 

@@ -57,9 +57,11 @@ void validate(const ir::Evaluator& f, const std::vector<Interval>& root, const R
             "subdivide: the shape takes {} coordinates but the root box has {} axes", f.dimension(), d));
     for (int a = 0; a < d; ++a) {
         const Interval x = root[static_cast<std::size_t>(a)];
-        if (!(std::isfinite(x.lo) && std::isfinite(x.hi) && x.lo < x.hi))
-            throw std::invalid_argument(fmt::format(
-                "subdivide: root axis {} is [{}, {}]; it needs finite bounds with lo < hi", a, x.lo, x.hi));
+        if (!(std::isfinite(x.lo) && std::isfinite(x.hi) && x.lo < x.hi && std::isfinite(x.hi - x.lo)))
+            throw std::invalid_argument(
+                fmt::format("subdivide: root axis {} is [{}, {}]; it needs finite bounds with lo < hi, and a "
+                            "width below the largest double",
+                            a, x.lo, x.hi));
     }
     if (o.split < 2 || o.split > 4)
         throw std::invalid_argument(fmt::format("subdivide: split {} is out of range [2, 4]", o.split));
