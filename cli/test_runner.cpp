@@ -25,40 +25,57 @@ std::string value_text(const driver::ClosedValue& v) {
     return fmt::format("{} in {}", *v.point, format_interval(v.enclosure));
 }
 
-void run_prints(const front::Compilation& c, const EngineOptions& engine, driver::QueryAnswers& answers) {
-    const front::Module& m = c.module;
-    for (const front::PrintInfo& p : m.prints) {
-        switch (p.kind) {
-        case front::ValueKind::interval: std::cout << format_interval(p.box[0]) << "\n"; break;
-        case front::ValueKind::box: {
-            std::string s;
-            for (std::size_t i = 0; i < p.box.size(); ++i) s += (i ? " × " : "") + format_interval(p.box[i]);
-            std::cout << s << "\n";
-            break;
+// One print statement's line on stdout.
+void run_print(const front::Module& m, const front::PrintInfo& p, const EngineOptions& engine,
+               driver::QueryAnswers& answers) {
+    switch (p.kind) {
+    case front::ValueKind::interval: std::cout << format_interval(p.box[0]) << "\n"; break;
+    case front::ValueKind::box: {
+        std::string s;
+        for (std::size_t i = 0; i < p.box.size(); ++i) s += (i ? " × " : "") + format_interval(p.box[i]);
+        std::cout << s << "\n";
+        break;
+    }
+    case front::ValueKind::boolean:
+        std::cout << truth_text(driver::evaluate_closed(m, p.nodes[0], engine, answers, false).enclosure)
+                  << "\n";
+        break;
+    case front::ValueKind::scalar:
+    case front::ValueKind::point: {
+        std::string s;
+        for (std::size_t i = 0; i < p.nodes.size(); ++i) {
+            const driver::ClosedValue v = driver::evaluate_closed(m, p.nodes[i], engine, answers);
+            s += (i ? ", " : "") + value_text(v);
         }
-        case front::ValueKind::boolean:
-            std::cout << truth_text(driver::evaluate_closed(m, p.nodes[0], engine, answers, false).enclosure)
-                      << "\n";
-            break;
-        case front::ValueKind::scalar:
-        case front::ValueKind::point: {
-            std::string s;
-            for (std::size_t i = 0; i < p.nodes.size(); ++i) {
-                const driver::ClosedValue v = driver::evaluate_closed(m, p.nodes[i], engine, answers);
-                s += (i ? ", " : "") + value_text(v);
-            }
-            std::cout << (p.kind == front::ValueKind::point ? "(" + s + ")" : s) << "\n";
-            break;
-        }
+        std::cout << (p.kind == front::ValueKind::point ? "(" + s + ")" : s) << "\n";
+        break;
+    }
+    }
+}
+
+// Runs every print statement; one that cannot be done (a dimension the automaton does not allow, a
+// limit) is reported at the statement, with its line and a caret, and the others still run. Returns
+// whether all were done.
+bool run_prints(const front::Compilation& c, const EngineOptions& engine, driver::QueryAnswers& answers) {
+    front::Diagnostics failures;
+    for (const front::PrintInfo& p : c.module.prints) {
+        try {
+            run_print(c.module, p, engine, answers);
+        } catch (const driver::RunError& e) {
+            failures.error(p.loc, e.what());
         }
     }
+    if (!failures.has_errors()) return true;
+    std::cout.flush();
+    std::cerr << failures.render(c.sources);
+    return false;
 }
 
 } // namespace
 
 int run_tests(const std::vector<std::string>& files, bool prints, const EngineOptions& engine) {
     int passed = 0, failed = 0;
-    bool compile_failed = false, any_tests = false;
+    bool compile_failed = false, any_tests = false, print_failed = false;
     for (const std::string& file : files) {
         auto c = compile_or_report(file);
         if (!c) {
@@ -66,7 +83,7 @@ int run_tests(const std::vector<std::string>& files, bool prints, const EngineOp
             continue;
         }
         driver::QueryAnswers answers;
-        if (prints) run_prints(*c, engine, answers);
+        if (prints && !run_prints(*c, engine, answers)) print_failed = true;
         for (const front::TestInfo& t : c->module.tests) {
             any_tests = true;
             const driver::TestOutcome outcome = driver::run_test(c->module, t, engine, answers);
@@ -95,7 +112,7 @@ int run_tests(const std::vector<std::string>& files, bool prints, const EngineOp
     }
     if (!prints || any_tests) std::cout << fmt::format("{} passed, {} failed\n", passed, failed);
     if (compile_failed) return front::exit_compile_error;
-    return failed ? 1 : 0;
+    return failed || print_failed ? 1 : 0;
 }
 
 } // namespace frac::cli
