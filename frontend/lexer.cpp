@@ -86,7 +86,9 @@ Tok keyword_or_ident(std::string_view word) {
 class Lexer {
 public:
     Lexer(std::string_view text, std::uint32_t file, Diagnostics& diags)
-        : s_(text), file_(file), diags_(diags) {}
+        : s_(text), file_(file), diags_(diags) {
+        if (s_.substr(0, 3) == "\xEF\xBB\xBF") pos_ = 3; // a UTF-8 byte order mark, as editors write it
+    }
 
     std::vector<Token> run() {
         std::vector<Token> out;
@@ -108,6 +110,18 @@ public:
 
 private:
     Location here() const { return {file_, line_, col_}; }
+    // The bytes of the well-formed UTF-8 character of two to four bytes at `at`, else 1.
+    std::size_t utf8_length(std::size_t at) const {
+        const auto lead = static_cast<unsigned char>(s_[at]);
+        const std::size_t n = lead >= 0xC2 && lead <= 0xDF   ? 2
+                              : lead >= 0xE0 && lead <= 0xEF ? 3
+                              : lead >= 0xF0 && lead <= 0xF4 ? 4
+                                                             : 1;
+        if (n == 1 || at + n > s_.size()) return 1;
+        for (std::size_t k = 1; k < n; ++k)
+            if ((static_cast<unsigned char>(s_[at + k]) & 0xC0) != 0x80) return 1;
+        return n;
+    }
     char peek(std::size_t k = 0) const { return pos_ + k < s_.size() ? s_[pos_ + k] : '\0'; }
     void advance() {
         const char c = s_[pos_++];
@@ -210,6 +224,14 @@ private:
                 t.text = text;
                 return true;
             }
+        }
+        const std::size_t length = utf8_length(pos_);
+        if (length > 1) {
+            // One character of several bytes: one error, the character shown as written.
+            diags_.error(t.loc, fmt::format("unexpected character '{}' (names and operators are ASCII)",
+                                            s_.substr(pos_, length)));
+            for (std::size_t k = 0; k < length; ++k) advance();
+            return false;
         }
         std::string shown(1, c);
         if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7F)
