@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <oneapi/tbb/global_control.h>
 #include <optional>
@@ -85,6 +86,22 @@ int main(int argc, char** argv) {
 
 namespace {
 
+// A whole number written in decimal digits that fits in 64 bits (no sign: "-1" would wrap around), of at
+// least `least`; CLI11's own checks print ranges such as "0.000000 to 1.797693e+308".
+CLI::Validator whole_number(std::uint64_t least) {
+    return CLI::Validator(
+        [least](std::string& text) -> std::string {
+            const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+            errno = 0;
+            const unsigned long long v = digits ? std::strtoull(text.c_str(), nullptr, 10) : 0;
+            if (!digits || errno == ERANGE || v < least)
+                return fmt::format("'{}' is not a whole number from {} to {}", text, least,
+                                   std::numeric_limits<std::uint64_t>::max());
+            return "";
+        },
+        least > 0 ? "POSITIVE" : "");
+}
+
 int run(int argc, char** argv) {
     using namespace frac;
     CLI::App app{"frac: fractal geometric modeling with guaranteed interval evaluation", "frac"};
@@ -107,6 +124,7 @@ int run(int argc, char** argv) {
                [&](const std::uint64_t& seed) { free_entry_seed = seed; },
                "give the free entries of every bcifs values drawn from this seed (reproducible) instead "
                "of the most uniform ones")
+            ->check(whole_number(0))
             ->type_name("N");
     };
     auto add_engine = [&](CLI::App* sub) {
@@ -136,7 +154,7 @@ int run(int argc, char** argv) {
                fmt::format("most cells the subdivision evaluates and keeps (default: FRAC_MAX_CELLS, "
                            "else {}); a run foreseen to pass it is refused",
                            rt::default_max_cells))
-            ->check(CLI::PositiveNumber);
+            ->check(whole_number(1));
     };
 
     std::string file, shape, emit, at, box;
@@ -220,7 +238,7 @@ int run(int argc, char** argv) {
     mesh->add_option("--max-triangles", mesh_options.limits.triangles,
                      fmt::format("most triangles of the mesh (default: FRAC_MAX_TRIANGLES, else {})",
                                  cli::default_max_triangles))
-        ->check(CLI::PositiveNumber);
+        ->check(whole_number(1));
     add_engine(mesh);
 
     int from = 4, to = 9, split = 2;
@@ -271,6 +289,7 @@ int run(int argc, char** argv) {
     chaos->add_option("-n,--points", chaos_options.points, "points recorded")->capture_default_str();
     chaos->add_option("-o,--output", chaos_options.output, "picture file (.png)")->required();
     chaos->add_option("--seed", chaos_options.seed, "random seed: the same seed gives the same picture")
+        ->check(whole_number(0))
         ->capture_default_str();
     chaos->add_option("--threads", chaos_options.threads, "threads (the picture depends on their number)")
         ->check(CLI::Range(1, 256))
