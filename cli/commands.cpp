@@ -242,6 +242,12 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
                                      s.name));
     auto eval = make_evaluator(c->module, s.root, s.dimension, for_covers(engine));
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
+    // Checked before the cover, which may take long.
+    if (slice_axis >= 0 && !(slice_value >= box[static_cast<std::size_t>(slice_axis)].lo &&
+                             slice_value <= box[static_cast<std::size_t>(slice_axis)].hi))
+        throw UsageError(fmt::format("--slice {}: the value lies outside the box ({} from {} to {})", o.slice,
+                                     "xyz"[slice_axis], box[static_cast<std::size_t>(slice_axis)].lo,
+                                     box[static_cast<std::size_t>(slice_axis)].hi));
     rt::RssResult full = cover(box, o.depth, o.split, true, engine.threads, *eval, o.limits);
     const FreedAtExit keep_cover(full);
     eval.reset(); // no more evaluation: a background compile not started yet is dropped
@@ -258,12 +264,7 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
         return 0;
     }
     rt::Cover section;
-    if (slice_axis >= 0) {
-        if (!(slice_value >= box[static_cast<std::size_t>(slice_axis)].lo &&
-              slice_value <= box[static_cast<std::size_t>(slice_axis)].hi))
-            throw UsageError(fmt::format("--slice {}: the value lies outside the box", o.slice));
-        section = rt::slice(full, slice_value, slice_axis);
-    }
+    if (slice_axis >= 0) section = rt::slice(full, slice_value, slice_axis);
     const rt::Cover& r = slice_axis >= 0 ? section : static_cast<const rt::Cover&>(full);
     if (!o.ascii.empty()) std::cout << rt::ascii_picture(r, cols, rows);
     if (!o.output.empty()) {

@@ -2,18 +2,20 @@
 #include "cli/fit_curve.hpp"
 
 #include "cli/session.hpp"
+#include "frontend/builtins.hpp"
 #include "frontend/diagnostics.hpp"
+#include "frontend/lexer.hpp"
+#include "frontend/loader.hpp"
 #include "runtime/fit/generate.hpp"
 #include "runtime/fit/hough.hpp"
 #include "runtime/fit/least_squares.hpp"
 #include "support/atomic_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 
 namespace frac::cli {
 
@@ -25,16 +27,16 @@ struct DataFileError : std::runtime_error {
 };
 
 rt::fit::Samples read_samples(const std::string& path, rt::fit::DataKind kind) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw UsageError(fmt::format("cannot read '{}'", path));
-    std::ostringstream text;
-    text << in.rdbuf();
+    // As a model is read (a directory, a device or a file past the size limit: refused, with why).
+    std::string text, why;
+    if (!front::read_file(path, frontend_limits().max_file_bytes, text, why))
+        throw UsageError(fmt::format("cannot read '{}': {}", path, why));
     try {
-        return rt::fit::parse_csv(text.str(), kind);
+        return rt::fit::parse_csv(text, kind);
     } catch (const rt::fit::SamplesError& e) {
         if (e.line == 0) throw DataFileError(fmt::format("{}: error: {}\n", path, e.what()));
         front::SourceManager sources;
-        const auto id = sources.add(path, text.str());
+        const auto id = sources.add(path, text);
         front::Diagnostics diags;
         diags.error({id, std::uint32_t(e.line), std::uint32_t(std::max<std::size_t>(e.column, 1))}, e.what());
         throw DataFileError(diags.render(sources));
@@ -83,6 +85,22 @@ void report_hough(const rt::fit::HoughResult& r) {
     }
 }
 
+// The fitted model's name must be free in a model: not a keyword, a builtin function or constant
+// (checked before the fit, which takes seconds).
+void check_model_name(const std::string& name, bool from_output) {
+    front::Diagnostics ignored;
+    const std::vector<front::Token> tokens = front::lex(name, 0, ignored);
+    const std::vector<std::string> builtins = front::builtin_names();
+    const bool keyword = tokens.size() != 2 || tokens[0].kind != front::Tok::ident;
+    if (!keyword && !front::is_builtin_constant(name) &&
+        std::find(builtins.begin(), builtins.end(), name) == builtins.end())
+        return;
+    throw UsageError(fmt::format("the model cannot be named '{}'{}: it is {} of the language; {}", name,
+                                 from_output ? " (after the output file)" : "",
+                                 keyword ? "a keyword" : "a builtin name",
+                                 from_output ? "give another with --name" : "choose another --name"));
+}
+
 } // namespace
 
 void add_fit_curve_options(CLI::App* fit, FitCurveOptions& o) {
@@ -113,7 +131,10 @@ int run_fit_curve(const FitCurveOptions& o) {
     if (o.quantize != 0 && o.quantize != 8)
         throw UsageError(
             fmt::format("--quantize {}: curve fits store parameters in 8 bits or in full", o.quantize));
-    if (!o.output.empty()) check_output_writable(o.output, {o.file});
+    if (!o.output.empty()) {
+        check_output_writable(o.output, {o.file});
+        check_model_name(model_name(o), o.name.empty());
+    }
     const auto kind = o.kind == "function" ? rt::fit::DataKind::function
                       : o.kind == "curve"  ? rt::fit::DataKind::curve
                                            : rt::fit::DataKind::automatic;

@@ -4,6 +4,7 @@
 #include "driver/tests.hpp"
 #include "ir/semantics.hpp"
 
+#include <cmath>
 #include <fmt/format.h>
 #include <iostream>
 
@@ -21,7 +22,8 @@ std::string truth_text(ir::Interval t) {
 std::string value_text(const driver::ClosedValue& v) {
     if (v.enclosure.is_thin()) return fmt::format("{}", v.enclosure.lo);
     if (v.enclosure.is_empty()) return "empty";
-    if (!v.point) return format_interval(v.enclosure);
+    // A point value that is no number (inf / inf in a constant) tells nothing beyond the enclosure.
+    if (!v.point || std::isnan(*v.point)) return format_interval(v.enclosure);
     return fmt::format("{} in {}", *v.point, format_interval(v.enclosure));
 }
 
