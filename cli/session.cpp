@@ -9,7 +9,6 @@
 #include <fmt/format.h>
 #include <iostream>
 #include <mutex>
-#include <sstream>
 #include <string_view>
 
 namespace frac::cli {
@@ -139,11 +138,19 @@ const front::ShapeInfo& pick_shape(const front::Compilation& c, const std::strin
 
 namespace {
 
+// The parts of `text` between the separators outside parentheses and brackets (a coordinate may be
+// max(1, 2) or an interval [0, 1]).
 std::vector<std::string> split(const std::string& text, char sep) {
-    std::vector<std::string> parts;
-    std::stringstream ss(text);
-    std::string part;
-    while (std::getline(ss, part, sep)) parts.push_back(part);
+    std::vector<std::string> parts(1);
+    int depth = 0;
+    for (const char c : text) {
+        depth += c == '(' || c == '[' ? 1 : c == ')' || c == ']' ? -1 : 0;
+        if (c == sep && depth == 0)
+            parts.emplace_back();
+        else
+            parts.back() += c;
+    }
+    if (parts.back().empty()) parts.pop_back(); // as getline: no empty part after a final separator
     return parts;
 }
 
@@ -161,6 +168,8 @@ std::string box_form(int dimension) {
 ConstantValue evaluate_constant(const std::string& text, const std::string& what) {
     // The text is the body of a constant of an otherwise empty model: the language's own parser,
     // name resolution and constant checks apply, and nothing of the user's model is in scope.
+    if (text.find_first_of(";\n") != std::string::npos || text.find("//") != std::string::npos)
+        throw UsageError(fmt::format("{} '{}' is one expression: no ';', comment or line break", what, text));
     const std::string source = "const value = " + text + ";\nprint value;\n";
     auto c = driver::compile_source("<command line>", source);
     if (!c->ok() || c->program.items.size() != 2 || c->module.prints.size() != 1 ||
