@@ -11,6 +11,7 @@
 #include "runtime/automata/tree.hpp"
 #include "runtime/dimension.hpp"
 #include "runtime/legend.hpp"
+#include "runtime/limits.hpp"
 #include "runtime/picture.hpp"
 
 #include <fmt/format.h>
@@ -43,8 +44,25 @@ void check_picture_output(const std::string& path, bool svg_allowed) {
     check_output_writable(path);
 }
 
+// Refuses, before any walk, a tree of more nodes than the limit (--max-cells, FRAC_MAX_CELLS, else
+// rt::default_max_tree_nodes) and an SVG drawing of it over the output size limit (unless forced).
+void check_tree_size(const ir::Automaton& a, int depth, const std::string& output, const WorkLimits& limits,
+                     bool force) {
+    const rt::TreeSize size = runtime_job([&] { return rt::tree_size(a, depth); });
+    const std::uint64_t limit = limit_of(limits.cells, "FRAC_MAX_CELLS", rt::default_max_tree_nodes);
+    if (size.nodes > static_cast<double>(limit))
+        throw cell_limit_error(rt::LimitError(
+            fmt::format("depth {}: the evaluation tree of {} has about {:.3g} nodes, more than the limit of "
+                        "{} nodes",
+                        depth, a.name, size.nodes, limit),
+            size.nodes, limit));
+    if (ends_with(output, ".svg")) check_output_size(output, size.svg_bytes, force);
+}
+
 // The primitives of the evaluation tree's leaves, one colour per state (.svg: curves as polylines).
-void draw_tree(const ir::Automaton& a, int depth, const std::string& output, int size) {
+void draw_tree(const ir::Automaton& a, int depth, const std::string& output, int size,
+               const WorkLimits& limits, bool force) {
+    check_tree_size(a, depth, output, limits, force);
     runtime_job([&] {
         if (ends_with(output, ".svg"))
             rt::write_tree_svg(a, depth, output);
@@ -130,13 +148,14 @@ int run_tree(const std::string& file, const TreeOptions& o) {
     if (!c) return front::exit_compile_error;
     const ir::Automaton& a = find_automaton(*c, o.name).automaton;
     if (o.output.empty()) { // the text dump (--emit=tree): each node's state and composite operator
+        check_tree_size(a, o.depth, o.output, o.limits, o.force);
         runtime_job([&] {
             rt::write_tree_text(a, o.depth, std::cout, o.matrices);
             return 0;
         });
         return 0;
     }
-    draw_tree(a, o.depth, o.output, o.size);
+    draw_tree(a, o.depth, o.output, o.size, o.limits, o.force);
     return 0;
 }
 
@@ -191,7 +210,7 @@ int render_automaton(const front::AutomatonInfo& info, const RenderOptions& o) {
         throw UsageError("--method chaos draws a .png; .svg is for --method tree or cover");
     if (method == "tree") {
         if (o.depth > 24) throw UsageError("--depth of an evaluation tree is at most 24");
-        draw_tree(a, o.depth, o.output, o.size);
+        draw_tree(a, o.depth, o.output, o.size, o.limits, o.force);
         return 0;
     }
     if (method == "chaos") {

@@ -121,6 +121,18 @@ int run_eval(const std::string& file, const std::string& shape, const std::strin
     return status;
 }
 
+std::uint64_t limit_of(std::uint64_t flag, const char* env, std::uint64_t fallback) {
+    if (flag > 0) return flag;
+    if (const auto v = positive_env(env, "cells or triangles"))
+        return static_cast<std::uint64_t>(std::min(*v, 1e19));
+    return fallback;
+}
+
+RunError cell_limit_error(const std::exception& e) {
+    return RunError(fmt::format(
+        "{}: lower --depth, or raise the limit with --max-cells N (or FRAC_MAX_CELLS=N)", e.what()));
+}
+
 namespace {
 
 rt::RssProgress terminal_progress(std::shared_ptr<bool> printed) {
@@ -135,14 +147,6 @@ rt::RssProgress terminal_progress(std::shared_ptr<bool> printed) {
                                  evaluated, static_cast<double>(evaluated) / s / 1e6)
                   << std::flush;
     };
-}
-
-// A work limit: the flag when given, else the environment variable, else the default.
-std::uint64_t limit_of(std::uint64_t flag, const char* env, std::uint64_t fallback) {
-    if (flag > 0) return flag;
-    if (const auto v = positive_env(env, "cells or triangles"))
-        return static_cast<std::uint64_t>(std::min(*v, 1e19));
-    return fallback;
 }
 
 rt::RssResult cover(const std::vector<ir::Interval>& box, int depth, int split, bool keep_cells, int threads,
@@ -166,9 +170,7 @@ rt::RssResult cover(const std::vector<ir::Interval>& box, int depth, int split, 
         return r;
     } catch (const rt::LimitError& e) {
         if (*printed) std::cerr << "\n";
-        throw RunError(fmt::format("{}: lower --depth, or raise the limit with --max-cells N (or "
-                                   "FRAC_MAX_CELLS=N)",
-                                   e.what()));
+        throw cell_limit_error(e);
     } catch (const std::invalid_argument& e) {
         throw RunError(e.what());
     }

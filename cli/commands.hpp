@@ -20,6 +20,10 @@ struct WorkLimits {
     std::uint64_t cells = 0, triangles = 0;
 };
 inline constexpr std::uint64_t default_max_triangles = std::uint64_t{1} << 26; // about 1.5 GB with vertices
+// A work limit: the flag when given (not 0), else the environment variable `env`, else `fallback`.
+std::uint64_t limit_of(std::uint64_t flag, const char* env, std::uint64_t fallback);
+// The RunError of a run refused by its cell limit (rt::LimitError): its message, and how to raise the limit.
+RunError cell_limit_error(const std::exception& e);
 
 struct RenderOptions {
     std::string shape, box, output, kind = "both", ascii, slice, method;
@@ -65,6 +69,8 @@ struct TreeOptions {
     std::string name, output; // no output: the text dump of the tree
     int depth = 3, size = 1024;
     bool matrices = true; // the dump shows each node's composite operator
+    bool force = false;   // write an SVG over the size limit
+    WorkLimits limits;    // cells: the tree's nodes (default rt::default_max_tree_nodes)
 };
 // frac tree FILE NAME --depth n [-o FILE.png|FILE.svg]: the evaluation tree, one colour per state.
 int run_tree(const std::string& file, const TreeOptions& options);

@@ -3,6 +3,8 @@
 #include "cli/commands.hpp"
 #include "cli/fit_curve.hpp"
 #include "frontend/suggest.hpp"
+#include "runtime/automata/attractor_cover.hpp"
+#include "runtime/automata/tree.hpp"
 #include "runtime/rss.hpp"
 
 #include <algorithm>
@@ -148,12 +150,12 @@ int run(int argc, char** argv) {
     };
 
     // The work limits of the subdividing commands (runtime/limits.hpp).
-    auto add_cell_limit = [](CLI::App* sub, cli::WorkLimits& limits) {
+    auto add_cell_limit = [](CLI::App* sub, cli::WorkLimits& limits, const std::string& automata = "") {
         sub->add_option(
                "--max-cells", limits.cells,
                fmt::format("most cells the subdivision evaluates and keeps (default: FRAC_MAX_CELLS, "
-                           "else {}); a run foreseen to pass it is refused",
-                           rt::default_max_cells))
+                           "else {}){}; a run foreseen to pass it is refused",
+                           rt::default_max_cells, automata))
             ->check(whole_number(1));
     };
 
@@ -205,7 +207,10 @@ int run(int argc, char** argv) {
         "--slice", render_options.slice,
         "3D shapes: draw the section by the plane AXIS=VALUE (x, y or z), e.g. z=0.5; without it "
         "a 3D shape is drawn as a shaded relief seen from +z (.png)");
-    add_cell_limit(render, render_options.limits);
+    add_cell_limit(render, render_options.limits,
+                   fmt::format("; automata: the nodes of the tree (else {}), the cells of a level of the "
+                               "cover (else {})",
+                               rt::default_max_tree_nodes, rt::AttractorCoverOptions{}.max_cells));
     add_engine(render);
 
     cli::MeshOptions mesh_options;
@@ -269,6 +274,12 @@ int run(int argc, char** argv) {
                      "picture file: .png or .svg (curves as polylines); without it the tree is printed");
     tree->add_option("--size", tree_options.size, "picture width and height in pixels")
         ->capture_default_str();
+    tree->add_flag("--force", tree_options.force, "write an SVG estimated above 100 MB");
+    tree->add_option("--max-cells", tree_options.limits.cells,
+                     fmt::format("most nodes of the tree (default: FRAC_MAX_CELLS, else {}); a deeper tree "
+                                 "is refused before it is walked",
+                                 rt::default_max_tree_nodes))
+        ->check(CLI::PositiveNumber);
     bool tree_no_matrices = false;
     tree->add_flag("--no-matrices", tree_no_matrices, "print the nodes' states and addresses only");
     std::string tree_emit;

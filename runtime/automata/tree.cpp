@@ -54,6 +54,13 @@ struct Plane {
     }
 };
 
+// Whether a state's primitive is drawn as it is (else a state with arcs shows its attractor point).
+bool drawable(const ir::Primitive& p) {
+    return (p.kind == ir::Primitive::Kind::points || p.kind == ir::Primitive::Kind::polyline ||
+            p.kind == ir::Primitive::Kind::polygon) &&
+           p.points.cols() > 0;
+}
+
 // Calls shape(state, kind, points in the plane) for every leaf.
 template <typename Shape>
 void leaf_shapes(const ir::Automaton& a, int depth, Shape&& shape) {
@@ -63,12 +70,8 @@ void leaf_shapes(const ir::Automaton& a, int depth, Shape&& shape) {
     std::vector<ir::Primitive::Kind> kinds(a.states.size());
     for (std::size_t s = 0; s < a.states.size(); ++s) {
         const ir::Primitive& p = a.states[s].primitive;
-        const bool drawable =
-            (p.kind == ir::Primitive::Kind::points || p.kind == ir::Primitive::Kind::polyline ||
-             p.kind == ir::Primitive::Kind::polygon) &&
-            p.points.cols() > 0;
-        kinds[s] = drawable ? p.kind : ir::Primitive::Kind::points;
-        if (drawable) {
+        kinds[s] = drawable(p) ? p.kind : ir::Primitive::Kind::points;
+        if (drawable(p)) {
             if (p.points.rows() != static_cast<std::size_t>(a.states[s].space.coordinates()))
                 throw std::invalid_argument(
                     fmt::format("the primitive of state {} has points of the wrong size", a.states[s].name));
@@ -188,6 +191,42 @@ std::array<std::uint8_t, 3> state_colour(std::size_t state) {
                                                                          {227, 119, 194},
                                                                          {23, 190, 207}}};
     return palette[state % palette.size()];
+}
+
+TreeSize tree_size(const ir::Automaton& a, int depth) {
+    if (depth < 0 || depth > 64)
+        throw std::invalid_argument(fmt::format("tree depth {} is outside [0, 64]", depth));
+    require_well_formed(a);
+    const std::size_t n = a.states.size();
+    // Per state: whether it has arcs, and the SVG bytes of one leaf in it (write_tree_svg: a circle of
+    // about 60 bytes per point; a polyline or polygon of about 70 bytes and 16 per point).
+    std::vector<bool> inner(n, false);
+    for (const ir::Arc& arc : a.arcs) inner[arc.from] = true;
+    std::vector<double> bytes(n, 0.0);
+    for (std::size_t s = 0; s < n; ++s) {
+        const ir::Primitive& p = a.states[s].primitive;
+        const double points = static_cast<double>(p.points.cols());
+        if (drawable(p))
+            bytes[s] = p.kind == ir::Primitive::Kind::points || points == 1 ? 60 * points : 70 + 16 * points;
+        else if (inner[s])
+            bytes[s] = 60; // its attractor point
+    }
+    TreeSize size;
+    std::vector<double> count(n, 0.0), next(n, 0.0); // nodes of the level in each state
+    count[a.initial] = 1;
+    for (int k = 0;; ++k) {
+        for (std::size_t s = 0; s < n; ++s) {
+            size.nodes += count[s];
+            if (k < depth && inner[s]) continue;
+            size.leaves += count[s];
+            size.svg_bytes += count[s] * bytes[s];
+        }
+        if (k == depth) break;
+        std::fill(next.begin(), next.end(), 0.0);
+        for (const ir::Arc& arc : a.arcs) next[arc.to] += count[arc.from];
+        count.swap(next);
+    }
+    return size;
 }
 
 TreeStats walk_tree(const ir::Automaton& a, const TreeOptions& options,

@@ -39,6 +39,16 @@ struct TreeStats {
     std::size_t stack_bytes = 0; // the walk's own storage for composites and the address (O(depth))
 };
 
+// The size of the tree to `depth`, counted level by level over the states before any walk (in doubles:
+// no overflow, however many nodes): its nodes, its leaves and the bytes of its SVG drawing
+// (write_tree_svg, about). Throws std::invalid_argument as walk_tree does.
+struct TreeSize {
+    double nodes = 0, leaves = 0, svg_bytes = 0;
+};
+TreeSize tree_size(const ir::Automaton& a, int depth);
+// The most nodes of a tree frac walks unless raised (--max-cells or FRAC_MAX_CELLS): some 10 s of work.
+inline constexpr std::uint64_t default_max_tree_nodes = std::uint64_t{1} << 25;
+
 // Visits every node in depth-first order, children in arc order; the references in a node are valid
 // during the call only. Throws std::invalid_argument for a depth outside [0, 64] or an automaton whose
 // arcs do not fit its states (run ir::check_automaton first).

@@ -5,6 +5,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -126,4 +127,27 @@ TEST_CASE("drawings of the leaves, one colour per state", "[automata][tree]") {
     for (std::size_t at2 = 0; (at2 = text.str().find("<polyline", at2)) != std::string::npos; ++at2) ++lines;
     CHECK(lines == 2 * 32); // two segments, 2^5 leaves below each
     std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("the tree's size is counted before the walk, without overflow", "[automata][tree]") {
+    const ir::Automaton cubic = bspline(3, {{0, 0}, {1, 2}, {3, 2}, {4, 0}, {6, 1}});
+    for (const ir::Automaton& a : {sierpinski(), cubic, quadratic_with_polygon()})
+        for (int depth : {0, 1, 4, 9}) {
+            const rt::TreeStats walked = rt::walk_tree(a, {depth, false}, [](const rt::TreeNode&) {});
+            const rt::TreeSize counted = rt::tree_size(a, depth);
+            CHECK(counted.nodes == static_cast<double>(walked.nodes));
+            CHECK(counted.leaves == static_cast<double>(walked.leaves));
+        }
+    // 3^64 leaves: far beyond 64-bit counters, still a number to compare with a limit.
+    const rt::TreeSize deep = rt::tree_size(sierpinski(), 64);
+    CHECK(deep.leaves == Approx(std::pow(3.0, 64)));
+    CHECK(deep.nodes == Approx((std::pow(3.0, 65) - 1) / 2));
+    // The SVG estimate is near the file written (polylines of 3 points: 2 segments, 2^6 leaves).
+    const auto path = std::filesystem::temp_directory_path() / "frac_tree_size.svg";
+    rt::write_tree_svg(quadratic_with_polygon(), 6, path.string());
+    const double written = static_cast<double>(std::filesystem::file_size(path));
+    std::filesystem::remove(path);
+    const double foreseen = rt::tree_size(quadratic_with_polygon(), 6).svg_bytes;
+    CHECK(foreseen > 0.7 * written);
+    CHECK(foreseen < 1.3 * written);
 }
