@@ -73,6 +73,29 @@ void draw_tree(const ir::Automaton& a, int depth, const std::string& output, int
     std::cout << fmt::format("wrote {} (evaluation tree of {} to depth {})\n", output, a.name, depth);
 }
 
+// The options of an attractor cover to --depth (grid level depth - 3, then 3 refinements of the kept
+// cells) within --max-cells (else FRAC_MAX_CELLS, else the cover's own budget) cells a level, and 32 arcs
+// a cell.
+rt::AttractorCoverOptions cover_options(const RenderOptions& o) {
+    if (o.depth < 3 || o.depth > 14) throw UsageError("--depth of an attractor cover is 3 to 14");
+    rt::AttractorCoverOptions co;
+    co.refinements = 3;
+    co.initial_level = o.depth - co.refinements;
+    co.max_cells = limit_of(o.limits.cells, "FRAC_MAX_CELLS", co.max_cells);
+    co.max_arcs = co.max_cells > UINT64_MAX / 32 ? UINT64_MAX : 32 * co.max_cells;
+    return co;
+}
+
+// Runs a cover: its refusals by the cell limit (rt::LimitError) as RunErrors saying how to raise it.
+template <class F>
+rt::AttractorCoverResult cover_job(F&& job) {
+    try {
+        return runtime_job(job);
+    } catch (const rt::LimitError& e) {
+        throw cell_limit_error(e);
+    }
+}
+
 // The cover's picture, and how each graph of the refinement went.
 void write_cover(const rt::AttractorCoverResult& cover, const RenderOptions& o, const std::string& name) {
     const rt::PictureKind kind = o.kind == "process" ? rt::PictureKind::process
@@ -81,7 +104,7 @@ void write_cover(const rt::AttractorCoverResult& cover, const RenderOptions& o, 
     if (ends_with(o.output, ".png"))
         rt::write_png(rt::with_legend(rt::render(cover, kind, o.size), kind), o.output);
     else
-        rt::write_svg(cover, o.output, kind);
+        write_cover_svg(cover, o.output, kind, o.force);
     for (const rt::CoverStep& s : cover.steps)
         std::cout << fmt::format("level {:2}: {} cells, {} arcs, {} kept, area {:.6g}\n", s.level, s.cells,
                                  s.arcs, s.kept, s.area);
@@ -223,13 +246,9 @@ int render_automaton(const front::AutomatonInfo& info, const RenderOptions& o) {
                                  d.recorded, co.seed);
         return 0;
     }
-    // A cover by cell graphs (seed 000 sec. 2.4) in the box of the attractor's proven bounding ball:
-    // grid level depth - 3, then 3 refinements of the kept cells.
-    if (o.depth < 3 || o.depth > 14) throw UsageError("--depth of an attractor cover is 3 to 14");
-    rt::AttractorCoverOptions co;
-    co.refinements = 3;
-    co.initial_level = o.depth - co.refinements;
-    write_cover(runtime_job([&] { return rt::automaton_attractor_cover(a, {}, co); }), o, info.name);
+    // A cover by cell graphs (seed 000 sec. 2.4) in the box of the attractor's proven bounding ball.
+    const rt::AttractorCoverOptions co = cover_options(o);
+    write_cover(cover_job([&] { return rt::automaton_attractor_cover(a, {}, co); }), o, info.name);
     return 0;
 }
 
@@ -239,7 +258,7 @@ int render_map(front::Compilation& c, const front::Item& map, const RenderOption
     if (o.box.empty())
         throw UsageError(fmt::format(
             "the attractor of the map '{}' is covered inside a box: give --box x0:x1,y0:y1", map.name));
-    if (o.depth < 3 || o.depth > 14) throw UsageError("--depth of an attractor cover is 3 to 14");
+    const rt::AttractorCoverOptions co = cover_options(o);
     const std::vector<ir::Interval> box = parse_box(o.box, 2);
     std::vector<ir::NodeId> components;
     try {
@@ -255,10 +274,7 @@ int render_map(front::Compilation& c, const front::Item& map, const RenderOption
         evaluators.push_back(make_evaluator(c.module, n, 2, engine));
         parts.push_back(evaluators.back().get());
     }
-    rt::AttractorCoverOptions co;
-    co.refinements = 3;
-    co.initial_level = o.depth - co.refinements;
-    write_cover(runtime_job([&] { return rt::map_attractor_cover(parts, box, co); }), o, map.name);
+    write_cover(cover_job([&] { return rt::map_attractor_cover(parts, box, co); }), o, map.name);
     return 0;
 }
 

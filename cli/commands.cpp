@@ -196,6 +196,14 @@ void check_output_size(const std::string& path, double bytes, bool force) {
                                path, bytes / 1e6, limit / 1e6));
 }
 
+void write_cover_svg(const rt::Cover& r, const std::string& path, rt::PictureKind kind, bool force) {
+    // About 48 bytes a rectangle (measured): the cover's inside and boundary leaves, the process's cells.
+    const double cells = static_cast<double>(r.inside + r.boundary) +
+                         (kind == rt::PictureKind::cover ? 0.0 : static_cast<double>(r.evaluated));
+    check_output_size(path, 48 * cells, force);
+    rt::write_svg(r, path, kind);
+}
+
 int run_render(const std::string& file, const RenderOptions& o, const EngineOptions& engine) {
     if (o.output.empty() && o.ascii.empty())
         throw UsageError("render needs -o FILE.png|FILE.svg or --ascii COLSxROWS");
@@ -274,13 +282,7 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
             if (ends_with(o.output, ".png")) {
                 rt::write_png(rt::with_legend(rt::render(r, kind, o.size), kind), o.output);
             } else {
-                // About 48 bytes a rectangle (measured): the cover's inside and boundary leaves, the
-                // process's cells.
-                const double cells =
-                    static_cast<double>(r.inside + r.boundary) +
-                    (kind == rt::PictureKind::cover ? 0.0 : static_cast<double>(r.evaluated));
-                check_output_size(o.output, 48 * cells, o.force);
-                rt::write_svg(r, o.output, kind);
+                write_cover_svg(r, o.output, kind, o.force);
             }
         } catch (const std::runtime_error& e) {
             throw RunError(e.what());

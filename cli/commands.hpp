@@ -3,6 +3,7 @@
 
 #include "cli/session.hpp"
 #include "runtime/mesh.hpp"
+#include "runtime/picture.hpp"
 
 #include <cstdint>
 #include <string>
@@ -41,6 +42,8 @@ int run_eval(const std::string& file, const std::string& shape, const std::strin
 inline constexpr double output_size_limit = 100e6;
 // Refuses (RunError) an output whose estimated size exceeds the limit unless forced.
 void check_output_size(const std::string& path, double bytes, bool force);
+// Writes the SVG picture of a cover after the size check.
+void write_cover_svg(const rt::Cover& cover, const std::string& path, rt::PictureKind kind, bool force);
 // Writes a mesh (format by extension) after the size check, and says so on stderr.
 void write_mesh_file(const rt::Mesh& mesh, const std::string& path, bool force);
 

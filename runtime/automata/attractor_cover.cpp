@@ -1,6 +1,7 @@
 #include "runtime/automata/attractor_cover.hpp"
 
 #include "runtime/automata/distance.hpp"
+#include "runtime/limits.hpp"
 #include "runtime/rss.hpp"
 
 #include <algorithm>
@@ -121,6 +122,38 @@ std::vector<bool> kept_vertices(const std::vector<std::uint64_t>& offsets,
     return keep;
 }
 
+// Refuses (LimitError), before the kept cells of `level` are split, a next level of more cells than the
+// limit, or a last level foreseen above it: the cells of the next level times the growth of the kept
+// cells over the last two graphs (at least 1) for each level after it. The growth of a cover's kept
+// cells rises towards 2^dimension as its cells shrink, so the foresight seldom overstates.
+void check_next_level(const std::vector<Grid>& grids, const std::vector<bool>& rec,
+                      const std::vector<std::size_t>& base, int level, int last, double kept_before,
+                      const AttractorCoverOptions& o) {
+    double next = 0, kept = 0;
+    for (std::size_t s = 0; s < grids.size(); ++s) {
+        const double k =
+            static_cast<double>(std::count(rec.begin() + static_cast<std::ptrdiff_t>(base[s]),
+                                           rec.begin() + static_cast<std::ptrdiff_t>(base[s + 1]), true));
+        kept += k;
+        next += k * (grids[s].dimension() == 2 ? 4 : 8);
+    }
+    const double growth = kept_before > 0 ? std::max(1.0, kept / kept_before) : 1.0;
+    const double foreseen = next * std::pow(growth, last - level - 1);
+    const double limit = static_cast<double>(std::min<std::uint64_t>(o.max_cells, UINT32_MAX - 1));
+    if (next > limit)
+        throw LimitError(
+            fmt::format("attractor cover: level {} would have {} cells, more than the limit of {} "
+                        "cells",
+                        level + 1, next, o.max_cells),
+            next, o.max_cells);
+    if (foreseen > limit)
+        throw LimitError(
+            fmt::format("attractor cover: level {} would have about {:.3g} cells (foreseen after "
+                        "level {}), more than the limit of {} cells",
+                        last, foreseen, level, o.max_cells),
+            foreseen, o.max_cells);
+}
+
 AttractorCoverResult build(const std::vector<Grid>& grids, std::size_t initial, const ImageFn& images,
                            const AttractorCoverOptions& o) {
     if (o.initial_level < 0 || o.refinements < 0)
@@ -146,11 +179,29 @@ AttractorCoverResult build(const std::vector<Grid>& grids, std::size_t initial, 
     std::uint64_t all = 0;
     for (std::size_t s = 0; s < ns; ++s) all += cells_of(s);
     if (all > o.max_cells)
-        throw std::runtime_error(
-            fmt::format("attractor cover: the first grid (level {}) has {} cells, over the "
-                        "budget of {} (max_cells)",
-                        o.initial_level, all, o.max_cells));
+        throw LimitError(fmt::format("attractor cover: the first grid (level {}) has {} cells, more than "
+                                     "the limit of {} cells",
+                                     o.initial_level, all, o.max_cells),
+                         static_cast<double>(all), o.max_cells);
+    // A large first grid is preceded by a coarse cover (some 256 times fewer cells) whose growth per
+    // level foretells the last level: a depth that would not fit is refused before the first grid.
+    if (o.refinements > 0 && o.initial_level >= 6 && all > (std::uint64_t(1) << 16)) {
+        AttractorCoverOptions coarse = o;
+        coarse.initial_level = o.initial_level - 4;
+        coarse.refinements = 2;
+        const std::vector<CoverStep> steps = build(grids, initial, images, coarse).steps;
+        const int at = coarse.initial_level + coarse.refinements;
+        const double cells = static_cast<double>(steps.back().cells);
+        const double growth = std::max(1.0, cells / std::max(1.0, static_cast<double>(steps[1].cells)));
+        const double foreseen = cells * std::pow(growth, last - at);
+        if (foreseen > static_cast<double>(o.max_cells))
+            throw LimitError(fmt::format("attractor cover: level {} would have about {:.3g} cells (foreseen "
+                                         "from a cover to level {}), more than the limit of {} cells",
+                                         last, foreseen, at, o.max_cells),
+                             foreseen, o.max_cells);
+    }
     std::vector<std::vector<Key>> kept(ns);
+    double kept_before = 0; // the cells the previous graph kept (0: none yet)
     for (std::size_t s = 0; s < ns; ++s) {
         kept[s].resize(cells_of(s));
         for (Key i = 0; i < kept[s].size(); ++i) kept[s][i] = i;
@@ -165,10 +216,10 @@ AttractorCoverResult build(const std::vector<Grid>& grids, std::size_t initial, 
         const std::size_t total = base[ns];
         step.cells = total;
         if (total > o.max_cells || total >= UINT32_MAX)
-            throw std::runtime_error(
-                fmt::format("attractor cover: level {} has {} cells, over the budget of {} "
-                            "(max_cells)",
-                            level, total, o.max_cells));
+            throw LimitError(fmt::format("attractor cover: level {} has {} cells, more than the limit of {} "
+                                         "cells",
+                                         level, total, o.max_cells),
+                             static_cast<double>(total), o.max_cells);
         num::UpwardRounding up;
         auto cell_box = [&](std::size_t s, Key k, int axis) {
             const auto p = position(k, n);
@@ -247,10 +298,10 @@ AttractorCoverResult build(const std::vector<Grid>& grids, std::size_t initial, 
                             }
                         }
                     if (targets.size() > o.max_arcs)
-                        throw std::runtime_error(
-                            fmt::format("attractor cover: level {} has more than {} arcs "
-                                        "(max_arcs)",
-                                        level, o.max_arcs));
+                        throw LimitError(fmt::format("attractor cover: level {} has more than the limit of "
+                                                     "{} arcs",
+                                                     level, o.max_arcs),
+                                         static_cast<double>(targets.size()), o.max_arcs);
                 }
                 offsets.push_back(targets.size());
             }
@@ -285,6 +336,7 @@ AttractorCoverResult build(const std::vector<Grid>& grids, std::size_t initial, 
                 ++counts.outside;
         }
         step.area = static_cast<double>(step.kept) * cell_volume;
+        if (level < last) check_next_level(grids, rec, base, level, last, kept_before, o);
         for (std::size_t s = 0; s < ns; ++s) {
             std::vector<Key> next;
             for (std::size_t i = 0; i < kept[s].size(); ++i) {
@@ -304,6 +356,7 @@ AttractorCoverResult build(const std::vector<Grid>& grids, std::size_t initial, 
         }
         step.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         out.steps.push_back(step);
+        kept_before = static_cast<double>(std::count(rec.begin(), rec.end(), true));
         if (level < last) n *= 2;
     }
 

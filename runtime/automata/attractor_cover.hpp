@@ -38,8 +38,10 @@ namespace frac::rt {
 struct AttractorCoverOptions {
     int initial_level = 6; // the first graph is built on the 2^initial_level grid (per axis)
     int refinements = 3;   // then the kept cells are split in two per axis, this many times
-    // Explicit budgets: cells of one graph (all states together) and arcs of one graph. Exceeding
-    // either throws std::runtime_error naming the level and the option.
+    // Explicit budgets: cells of one graph (all states together) and arcs of one graph. A graph that
+    // would pass either is refused (rt::LimitError, with the count or estimate) before it is built: the
+    // first grid at once, each later level from the cells kept before they are split, and the last
+    // level foreseen from the growth of the kept cells.
     std::uint64_t max_cells = std::uint64_t(1) << 22;
     std::uint64_t max_arcs = std::uint64_t(1) << 27;
 };
@@ -65,7 +67,7 @@ std::vector<bool> recurrent_vertices(const std::vector<std::uint64_t>& offsets,
 
 // The attractor of the orbits of x -> (f_0(x), ..., f_{d-1}(x)) inside `root` (d = 2 or 3 axes, each
 // component an evaluator of d coordinates). Throws std::invalid_argument on a bad root, component
-// count or level, std::runtime_error when a budget is exceeded.
+// count or level, rt::LimitError when a budget would be exceeded.
 AttractorCoverResult map_attractor_cover(const std::vector<ir::Evaluator*>& components,
                                          const std::vector<Interval>& root,
                                          const AttractorCoverOptions& options = {});

@@ -6,6 +6,7 @@
 #include "runtime/automata/attractor_cover.hpp"
 #include "runtime/automata/chaos.hpp"
 #include "runtime/dimension.hpp"
+#include "runtime/limits.hpp"
 #include "tests/unit/automata_examples.hpp"
 
 #include <catch2/catch.hpp>
@@ -300,8 +301,14 @@ TEST_CASE("attractor covers report bad input and budgets", "[cover]") {
     o.initial_level = 6;
     o.refinements = 6;
     o.max_cells = 20000;
+    CHECK_THROWS_AS(rt::map_attractor_cover(h.components(), {{-1.5, 1.5}, {-0.5, 0.5}}, o), rt::LimitError);
     CHECK_THROWS_WITH(rt::map_attractor_cover(h.components(), {{-1.5, 1.5}, {-0.5, 0.5}}, o),
-                      Catch::Contains("max_cells"));
+                      Catch::Contains("cells (foreseen after level 7), more than the limit of 20000 cells"));
+    // The first grid is refused before it is built.
+    o.initial_level = 8;
+    CHECK_THROWS_WITH(
+        rt::map_attractor_cover(h.components(), {{-1.5, 1.5}, {-0.5, 0.5}}, o),
+        Catch::Contains("the first grid (level 8) has 65536 cells, more than the limit of 20000"));
     CHECK_THROWS_AS(rt::map_attractor_cover(h.components(), {{-1.5, 1.5}}, {}), std::invalid_argument);
     CHECK_THROWS_AS(rt::map_attractor_cover(h.components(), {{1.5, -1.5}, {-0.5, 0.5}}, {}),
                     std::invalid_argument);
