@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <functional>
 #include <iostream>
 #include <stdexcept>
 #include <string_view>
@@ -31,6 +32,8 @@ template <class F>
 auto runtime_job(F&& job) {
     try {
         return job();
+    } catch (const rt::RangeError&) {
+        throw; // reported at the automaton (on_automaton)
     } catch (const std::invalid_argument& e) {
         throw RunError(e.what());
     }
@@ -157,6 +160,18 @@ int mesh_patches(const front::AutomatonInfo& info, const MeshOptions& o) {
 
 } // namespace
 
+int on_automaton(const front::Compilation& c, const front::AutomatonInfo& info,
+                 const std::function<int()>& job) {
+    try {
+        return job();
+    } catch (const rt::RangeError& e) {
+        front::Diagnostics diags;
+        diags.error(info.loc, e.what());
+        std::cerr << diags.render(c.sources);
+        return front::exit_runtime_error;
+    }
+}
+
 const front::AutomatonInfo& find_automaton(const front::Compilation& c, const std::string& name) {
     if (const front::AutomatonInfo* a = c.module.find_automaton(name)) return *a;
     std::vector<std::string> known;
@@ -169,7 +184,8 @@ int run_tree(const std::string& file, const TreeOptions& o) {
     if (!o.output.empty()) check_picture_output(o.output, true);
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
-    const ir::Automaton& a = find_automaton(*c, o.name).automaton;
+    const front::AutomatonInfo& info = find_automaton(*c, o.name);
+    const ir::Automaton& a = info.automaton;
     if (o.output.empty()) { // the text dump (--emit=tree): each node's state and composite operator
         check_tree_size(a, o.depth, o.output, o.limits, o.force);
         runtime_job([&] {
@@ -178,8 +194,10 @@ int run_tree(const std::string& file, const TreeOptions& o) {
         });
         return 0;
     }
-    draw_tree(a, o.depth, o.output, o.size, o.limits, o.force);
-    return 0;
+    return on_automaton(*c, info, [&] {
+        draw_tree(a, o.depth, o.output, o.size, o.limits, o.force);
+        return 0;
+    });
 }
 
 int run_solve(const std::string& file, const std::string& name) {
@@ -206,17 +224,19 @@ int run_chaos(const std::string& file, const ChaosCommandOptions& o) {
     if (o.size < 16 || o.size > 8192) throw UsageError("--size must be between 16 and 8192 pixels");
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
-    const ir::Automaton& a = find_automaton(*c, o.name).automaton;
+    const front::AutomatonInfo& info = find_automaton(*c, o.name);
     rt::ChaosOptions co;
     co.points = o.points;
     co.seed = o.seed;
     co.threads = o.threads;
     co.width = o.size;
-    const rt::Density d = runtime_job([&] { return rt::chaos_game(a, co); });
-    rt::write_density_png(d, o.output);
-    std::cout << fmt::format("wrote {} ({} points of {}, seed {}, over [{}, {}] × [{}, {}])\n", o.output,
-                             d.recorded, a.name, o.seed, d.x0, d.x1, d.y0, d.y1);
-    return 0;
+    return on_automaton(*c, info, [&] {
+        const rt::Density d = runtime_job([&] { return rt::chaos_game(info.automaton, co); });
+        rt::write_density_png(d, o.output);
+        std::cout << fmt::format("wrote {} ({} points of {}, seed {}, over [{}, {}] × [{}, {}])\n", o.output,
+                                 d.recorded, info.name, o.seed, d.x0, d.x1, d.y0, d.y1);
+        return 0;
+    });
 }
 
 int render_automaton(const front::AutomatonInfo& info, const RenderOptions& o) {

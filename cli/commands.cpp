@@ -226,7 +226,8 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
     const FreedAtExit keep_model(c);
-    if (const front::AutomatonInfo* a = c->module.find_automaton(o.shape)) return render_automaton(*a, o);
+    if (const front::AutomatonInfo* a = c->module.find_automaton(o.shape))
+        return on_automaton(*c, *a, [&] { return render_automaton(*a, o); });
     for (const front::Item& it : c->program.items)
         if (it.kind == front::ItemKind::fn && it.name == o.shape && !o.shape.empty())
             return render_map(*c, it, o, engine);
@@ -298,7 +299,7 @@ int run_dimension(const std::string& file, const std::string& shape, int from, i
     if (!c) return front::exit_compile_error;
     const FreedAtExit keep_model(c);
     if (const front::AutomatonInfo* a = c->module.find_automaton(shape))
-        return automaton_dimension(*a, from, to);
+        return on_automaton(*c, *a, [&] { return automaton_dimension(*a, from, to); });
     const front::ShapeInfo& s = pick_shape(*c, shape);
     auto eval = make_evaluator(c->module, s.root, s.dimension, for_covers(engine));
     const rt::RssResult r = cover(s.box, to, split, false, engine.threads, *eval, limits);

@@ -6,6 +6,7 @@
 #include "runtime/picture.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -87,6 +88,10 @@ struct ChaosCommandOptions {
 // frac chaos FILE NAME -n POINTS -o FILE.png: the chaos game's density, seeded and reproducible.
 int run_chaos(const std::string& file, const ChaosCommandOptions& options);
 const front::AutomatonInfo& find_automaton(const front::Compilation& c, const std::string& name);
+// Runs `job`, a command on the automaton `info`: an attractor past the range of doubles (rt::RangeError)
+// is reported at the automaton (file:line:col, the line and a caret) with exit code 1.
+int on_automaton(const front::Compilation& c, const front::AutomatonInfo& info,
+                 const std::function<int()>& job);
 // frac mesh of an ifs or cifs: its quad patch tessellated (.stl, .obj, .ply) or its curve as a polyline
 // (.svg, .obj).
 int mesh_automaton(const front::AutomatonInfo& a, const MeshOptions& options);

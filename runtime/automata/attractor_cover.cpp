@@ -532,6 +532,11 @@ AttractorCoverResult automaton_attractor_cover(const ir::Automaton& input, const
             grids[s] = make_grid(s == a.initial && !root.empty() ? root : box);
         }
     }
+    for (const Interval& r : grids[a.initial].root)
+        if (root.empty() && !(std::isfinite(r.lo) && std::isfinite(r.hi)))
+            throw RangeError(fmt::format("the attractor of '{}' leaves the range of doubles (its proven "
+                                         "bounding box is not finite): scale its coordinates down",
+                                         input.name));
     check_root(grids[a.initial].root, d);
     // Arcs in the direction of the points: x in A_b gives T x in A_a for an arc a -> b; states whose
     // attractor is empty get no cells' images (their vertices stay transient).

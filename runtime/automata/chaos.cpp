@@ -2,6 +2,7 @@
 
 #include "ir/automaton_check.hpp"
 #include "runtime/automata/points.hpp"
+#include "runtime/limits.hpp"
 
 #include <fmt/format.h>
 
@@ -294,7 +295,10 @@ Density chaos_game(const ir::Automaton& a, const ChaosOptions& o) {
             x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
         });
         if (!std::isfinite(x1 - x0) || !std::isfinite(y1 - y0))
-            throw std::runtime_error("the chaos game diverges (its points are not finite)");
+            throw RangeError(
+                fmt::format("the attractor of '{}' leaves the range of doubles (the chaos game's "
+                            "points are not finite): scale its coordinates down",
+                            a.name));
         const double span = std::max({x1 - x0, y1 - y0, 1e-12});
         // Flat attractors (a curve on y = 0, the Cantor set) still get a band of rows.
         const double mx = std::max(0.05 * (x1 - x0), 0.005 * span),

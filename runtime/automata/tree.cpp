@@ -2,6 +2,7 @@
 
 #include "ir/automaton_check.hpp"
 #include "runtime/automata/points.hpp"
+#include "runtime/limits.hpp"
 #include "support/atomic_file.hpp"
 
 #include <fmt/format.h>
@@ -109,17 +110,25 @@ struct View {
 
 View view_of(const ir::Automaton& a, int depth, int pixels) {
     double x0 = num::inf, x1 = -num::inf, y0 = num::inf, y1 = -num::inf;
+    bool finite = true;
     leaf_shapes(a, depth,
                 [&](std::size_t, ir::Primitive::Kind, const std::vector<std::array<double, 2>>& pts) {
                     for (const auto& p : pts) {
+                        finite = finite && std::isfinite(p[0]) && std::isfinite(p[1]);
                         x0 = std::min(x0, p[0]);
                         x1 = std::max(x1, p[0]);
                         y0 = std::min(y0, p[1]);
                         y1 = std::max(y1, p[1]);
                     }
                 });
-    if (!(x0 <= x1) || !std::isfinite(x1 - x0) || !std::isfinite(y1 - y0))
-        throw std::runtime_error("the evaluation tree draws nothing finite");
+    if (!finite || (x0 <= x1 && (!std::isfinite(x1 - x0) || !std::isfinite(y1 - y0))))
+        throw RangeError(fmt::format("the evaluation tree of '{}' leaves the range of doubles (what its "
+                                     "leaves draw is not finite): scale its coordinates down",
+                                     a.name));
+    if (!(x0 <= x1))
+        throw std::invalid_argument(fmt::format("the evaluation tree of '{}' to depth {} draws nothing: its "
+                                                "leaves have no primitive",
+                                                a.name, depth));
     // A margin of 2% and at least a tiny extent, so flat or single-point drawings still have a view.
     const double span = std::max({x1 - x0, y1 - y0, 1e-9});
     const double margin = 0.02 * span;
