@@ -13,6 +13,7 @@
 #include "runtime/legend.hpp"
 #include "runtime/limits.hpp"
 #include "runtime/picture.hpp"
+#include "runtime/relief.hpp"
 
 #include <fmt/format.h>
 
@@ -99,19 +100,41 @@ rt::AttractorCoverResult cover_job(F&& job) {
     }
 }
 
-// The cover's picture, and how each graph of the refinement went.
+// The cover's picture, and how each graph of the refinement went. A 3D cover is drawn as its section by
+// the plane of --slice, or as a shaded relief seen from +z (.png).
 void write_cover(const rt::AttractorCoverResult& cover, const RenderOptions& o, const std::string& name) {
     const rt::PictureKind kind = o.kind == "process" ? rt::PictureKind::process
                                  : o.kind == "cover" ? rt::PictureKind::cover
                                                      : rt::PictureKind::both;
-    if (ends_with(o.output, ".png"))
-        rt::write_png(rt::with_legend(rt::render(cover, kind, o.size), kind), o.output);
-    else
-        write_cover_svg(cover, o.output, kind, o.force);
+    const SliceRequest plane = parse_slice(o.slice);
+    std::string what = "cell-graph cover";
+    if (cover.dimension() == 3 && plane.axis < 0) {
+        rt::write_png(rt::relief_image(cover, o.size), o.output);
+        what = "relief of the cell-graph cover, seen from +z,";
+    } else {
+        const rt::Cover section = plane.axis >= 0 ? section_of(cover, plane, o.slice) : rt::Cover{};
+        const rt::Cover& picture = plane.axis >= 0 ? section : cover;
+        if (ends_with(o.output, ".png"))
+            rt::write_png(rt::with_legend(rt::render(picture, kind, o.size), kind), o.output);
+        else
+            write_cover_svg(picture, o.output, kind, o.force);
+        if (plane.axis >= 0) what = fmt::format("section {} of the cell-graph cover", o.slice);
+    }
     for (const rt::CoverStep& s : cover.steps)
-        std::cout << fmt::format("level {:2}: {} cells, {} arcs, {} kept, area {:.6g}\n", s.level, s.cells,
-                                 s.arcs, s.kept, s.area);
-    std::cout << fmt::format("wrote {} (cell-graph cover of {})\n", o.output, name);
+        std::cout << fmt::format("level {:2}: {} cells, {} arcs, {} kept, {} {:.6g}\n", s.level, s.cells,
+                                 s.arcs, s.kept, cover.dimension() == 3 ? "volume" : "area", s.area);
+    std::cout << fmt::format("wrote {} ({} of {})\n", o.output, what, name);
+}
+
+// Refuses, before any work, a --slice or an output a cover of `dimension` axes cannot be drawn to.
+void check_cover_picture(const RenderOptions& o, int dimension, const std::string& name) {
+    if (!o.slice.empty() && dimension != 3)
+        throw UsageError(fmt::format("--slice is for 3D shapes and covers; '{}' is {}D", name, dimension));
+    parse_slice(o.slice);
+    if (dimension == 3 && o.slice.empty() && !ends_with(o.output, ".png"))
+        throw UsageError(fmt::format("'{}' is 3D: draw a section of its cover with --slice z=VALUE, or a "
+                                     "relief (shaded depth image) as .png",
+                                     name));
 }
 
 // --layout NxM or N, --cells A,B,...
@@ -249,6 +272,8 @@ int render_automaton(const front::AutomatonInfo& info, const RenderOptions& o) {
         for (const ir::State& s : a.states)
             if (s.primitive.kind != ir::Primitive::Kind::none) method = "tree";
     }
+    if (!o.slice.empty() && method != "cover")
+        throw UsageError("--slice draws a section of a cover: give --method cover");
     if (method == "chaos" && ends_with(o.output, ".svg"))
         throw UsageError("--method chaos draws a .png; .svg is for --method tree or cover");
     if (method == "tree") {
@@ -268,6 +293,7 @@ int render_automaton(const front::AutomatonInfo& info, const RenderOptions& o) {
     }
     // A cover by cell graphs (seed 000 sec. 2.4) in the box of the attractor's proven bounding ball.
     const rt::AttractorCoverOptions co = cover_options(o);
+    check_cover_picture(o, a.output_dimension(), info.name);
     write_cover(cover_job([&] { return rt::automaton_attractor_cover(a, {}, co); }), o, info.name);
     return 0;
 }
@@ -279,6 +305,7 @@ int render_map(front::Compilation& c, const front::Item& map, const RenderOption
         throw UsageError(fmt::format(
             "the attractor of the map '{}' is covered inside a box: give --box x0:x1,y0:y1", map.name));
     const rt::AttractorCoverOptions co = cover_options(o);
+    check_cover_picture(o, 2, map.name);
     const std::vector<ir::Interval> box = parse_box(o.box, 2);
     std::vector<ir::NodeId> components;
     try {

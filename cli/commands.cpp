@@ -196,6 +196,32 @@ void check_output_size(const std::string& path, double bytes, bool force) {
                                path, bytes / 1e6, limit / 1e6));
 }
 
+SliceRequest parse_slice(const std::string& text) {
+    SliceRequest request;
+    if (text.empty()) return request;
+    const auto eq = text.find('=');
+    const std::string axis = text.substr(0, eq);
+    request.axis = axis == "x" ? 0 : axis == "y" ? 1 : axis == "z" ? 2 : -1;
+    if (eq == std::string::npos || request.axis < 0)
+        throw UsageError(fmt::format("--slice needs AXIS=VALUE such as z=0.5, not '{}'", text));
+    // A constant expression, as in --at (z=1/3 is the plane nearest to 1/3).
+    request.value = evaluate_constant(text.substr(eq + 1), "--slice: the value").point;
+    return request;
+}
+
+void check_slice_within(const SliceRequest& plane, const std::vector<ir::Interval>& box,
+                        const std::string& text) {
+    const ir::Interval axis = box[static_cast<std::size_t>(plane.axis)];
+    if (!(plane.value >= axis.lo && plane.value <= axis.hi))
+        throw UsageError(
+            fmt::format("--slice {}: the value lies outside the box [{}, {}]", text, axis.lo, axis.hi));
+}
+
+rt::Cover section_of(const rt::Cover& r, const SliceRequest& plane, const std::string& text) {
+    check_slice_within(plane, r.root, text);
+    return rt::slice(r, plane.value, plane.axis);
+}
+
 void write_cover_svg(const rt::Cover& r, const std::string& path, rt::PictureKind kind, bool force) {
     // About 48 bytes a rectangle (measured): the cover's inside and boundary leaves, the process's cells.
     const double cells = static_cast<double>(r.inside + r.boundary) +
@@ -235,30 +261,17 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
         throw UsageError("--method is for automata (ifs, cifs); shapes are drawn from their cover");
     const front::ShapeInfo& s = pick_shape(*c, o.shape);
     // A 3D shape is drawn as a plane section (--slice) or as a shaded relief of its cover from above.
-    int slice_axis = -1;
-    double slice_value = 0;
-    if (!o.slice.empty()) {
-        const auto eq = o.slice.find('=');
-        const std::string axis = o.slice.substr(0, eq);
-        slice_axis = axis == "x" ? 0 : axis == "y" ? 1 : axis == "z" ? 2 : -1;
-        if (eq == std::string::npos || slice_axis < 0)
-            throw UsageError(fmt::format("--slice needs AXIS=VALUE such as z=0.5, not '{}'", o.slice));
-        // A constant expression, as in --at (z=1/3 is the plane nearest to 1/3).
-        slice_value = evaluate_constant(o.slice.substr(eq + 1), "--slice: the value").point;
-        if (s.dimension != 3) throw UsageError(fmt::format("--slice is for 3D shapes; '{}' is 2D", s.name));
-    }
+    const SliceRequest plane = parse_slice(o.slice);
+    const int slice_axis = plane.axis;
+    if (slice_axis >= 0 && s.dimension != 3)
+        throw UsageError(fmt::format("--slice is for 3D shapes; '{}' is 2D", s.name));
     if (s.dimension == 3 && slice_axis < 0 && (!o.ascii.empty() || ends_with(o.output, ".svg")))
         throw UsageError(fmt::format("shape '{}' is 3D: draw a section with --slice z=VALUE, or a relief "
                                      "(shaded depth image) as .png",
                                      s.name));
     auto eval = make_evaluator(c->module, s.root, s.dimension, for_covers(engine));
     const auto box = o.box.empty() ? s.box : parse_box(o.box, s.dimension);
-    // Checked before the cover, which may take long.
-    if (slice_axis >= 0 && !(slice_value >= box[static_cast<std::size_t>(slice_axis)].lo &&
-                             slice_value <= box[static_cast<std::size_t>(slice_axis)].hi))
-        throw UsageError(fmt::format("--slice {}: the value lies outside the box ({} from {} to {})", o.slice,
-                                     "xyz"[slice_axis], box[static_cast<std::size_t>(slice_axis)].lo,
-                                     box[static_cast<std::size_t>(slice_axis)].hi));
+    if (slice_axis >= 0) check_slice_within(plane, box, o.slice); // before the cover, which may take long
     rt::RssResult full = cover(box, o.depth, o.split, true, engine.threads, *eval, o.limits);
     const FreedAtExit keep_cover(full);
     eval.reset(); // no more evaluation: a background compile not started yet is dropped
@@ -275,7 +288,7 @@ int run_render(const std::string& file, const RenderOptions& o, const EngineOpti
         return 0;
     }
     rt::Cover section;
-    if (slice_axis >= 0) section = rt::slice(full, slice_value, slice_axis);
+    if (slice_axis >= 0) section = section_of(full, plane, o.slice);
     const rt::Cover& r = slice_axis >= 0 ? section : static_cast<const rt::Cover&>(full);
     if (!o.ascii.empty()) std::cout << rt::ascii_picture(r, cols, rows);
     if (!o.output.empty()) {

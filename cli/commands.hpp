@@ -43,6 +43,18 @@ int run_eval(const std::string& file, const std::string& shape, const std::strin
 inline constexpr double output_size_limit = 100e6;
 // Refuses (RunError) an output whose estimated size exceeds the limit unless forced.
 void check_output_size(const std::string& path, double bytes, bool force);
+// --slice AXIS=VALUE (x, y or z; VALUE a constant expression); axis -1 when `text` is empty. Throws
+// UsageError when it is malformed.
+struct SliceRequest {
+    int axis = -1;
+    double value = 0;
+};
+SliceRequest parse_slice(const std::string& text);
+// UsageError, quoting `text`, when the plane misses `box`.
+void check_slice_within(const SliceRequest& plane, const std::vector<ir::Interval>& box,
+                        const std::string& text);
+// The 2D section of a 3D cover by the plane (UsageError, quoting `text`, when it misses the cover's box).
+rt::Cover section_of(const rt::Cover& cover, const SliceRequest& plane, const std::string& text);
 // Writes the SVG picture of a cover after the size check.
 void write_cover_svg(const rt::Cover& cover, const std::string& path, rt::PictureKind kind, bool force);
 // Writes a mesh (format by extension) after the size check, and says so on stderr.

@@ -205,8 +205,8 @@ int run(int argc, char** argv) {
     render->add_flag("--force", render_options.force, "write an SVG estimated above 100 MB");
     render->add_option(
         "--slice", render_options.slice,
-        "3D shapes: draw the section by the plane AXIS=VALUE (x, y or z), e.g. z=0.5; without it "
-        "a 3D shape is drawn as a shaded relief seen from +z (.png)");
+        "3D shapes and covers of automata in R3: draw the section by the plane AXIS=VALUE (x, y or z), "
+        "e.g. z=0.5; without it a 3D shape or cover is drawn as a shaded relief seen from +z (.png)");
     add_cell_limit(render, render_options.limits,
                    fmt::format("; automata: the nodes of the tree (else {}), the cells of a level of the "
                                "cover (else {})",
