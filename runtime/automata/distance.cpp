@@ -1,6 +1,7 @@
 #include "runtime/automata/distance.hpp"
 
 #include "runtime/automata/distance_bounds.hpp"
+#include "runtime/limits.hpp"
 
 #include "numeric/matrix.hpp"
 
@@ -95,12 +96,28 @@ std::vector<Interval> mat_vec(const Matrix<Interval>& m, const std::vector<Inter
 }
 
 // Upper bound of the euclidean norm of a - b over the space's coordinates (R^d: the last one is 1 in
-// both and dropped).
+// both and dropped). The differences are scaled by a power of two near the largest first (exactly), so
+// their squares neither overflow (differences past 1e154) nor underflow (below 1e-162) at any scale.
 double distance_upper(const std::vector<Interval>& a, const std::vector<Interval>& b, ir::Space s) {
     const std::size_t n = is_bary(s) ? a.size() : a.size() - 1;
+    std::vector<double> magnitude(n); // of each difference, an upper bound
+    double largest = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Interval d = num::sub(a[i], b[i]);
+        magnitude[i] = std::max(std::fabs(d.lo), std::fabs(d.hi));
+        largest = std::max(largest, magnitude[i]);
+    }
+    if (!(largest > 0) || !std::isfinite(largest)) return largest; // 0, inf or NaN (never a bound)
+    int exponent = 0;
+    std::frexp(largest, &exponent); // largest < 2^exponent
     Interval acc(0.0);
-    for (std::size_t i = 0; i < n; ++i) acc = num::add(acc, num::sqr(num::sub(a[i], b[i])));
-    return num::sqrt(acc).hi;
+    for (const double m : magnitude) {
+        double scaled = std::ldexp(m, -exponent); // exact, but where a small one falls to subnormals
+        if (std::ldexp(scaled, exponent) < m) scaled = std::nextafter(scaled, num::inf);
+        acc = num::add(acc, num::sqr(Interval(scaled)));
+    }
+    // sqrt(acc) <= sqrt(n): times 2^exponent it stays finite unless the distance itself is not.
+    return std::ldexp(num::sqrt(acc).hi, exponent);
 }
 
 std::vector<Interval> thin(const std::vector<double>& v) {
@@ -351,6 +368,10 @@ std::vector<StateBall> bounding_balls(const ir::Automaton& a) {
                                     a.states[arc.from].space);
         }
     }
+    // Every map contracting: the radii are bounded by the largest gap over 1 - the largest contraction,
+    // so radii past the doubles come from an attractor past them, not from maps that do not contract.
+    bool contracting = true;
+    for (std::size_t i : arcs) contracting = contracting && lip[i] < 1;
     std::vector<double> r(ns, 0.0);
     bool settled = false;
     for (int it = 0; it < 100000 && !settled; ++it) {
@@ -361,12 +382,17 @@ std::vector<StateBall> bounding_balls(const ir::Automaton& a) {
             next[arc.from] = std::max(next[arc.from], lip[i] * r[arc.to] + gap[i]);
         }
         for (std::size_t s = 0; s < ns; ++s) {
-            if (!std::isfinite(next[s]) || next[s] > 1e300)
+            if (!std::isfinite(next[s]) && contracting)
+                throw RangeError(fmt::format("the attractor of '{}' leaves the range of doubles (it has no "
+                                             "finite bounding ball): scale its coordinates down",
+                                             a.name));
+            if (!std::isfinite(next[s]))
                 throw std::invalid_argument(
                     fmt::format("no bounding balls for automaton '{}': they diverge, its operators do not "
                                 "contract in the euclidean norm of their spaces",
                                 a.name));
-            if (std::fabs(next[s] - r[s]) > 1e-14 * std::max(1.0, next[s])) settled = false;
+            // Relative: radii of 1e-300 settle as those of 1e300 do.
+            if (std::fabs(next[s] - r[s]) > 1e-14 * next[s]) settled = false;
         }
         r = next;
     }

@@ -5,6 +5,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <memory>
 #include <random>
 #include <set>
@@ -357,4 +358,35 @@ TEST_CASE("distance to the Cantor set in R1", "[distance]") {
     const num::Interval e = dist.eval_box(&box);
     CHECK(e.lo <= 0.4 - 1.0 / 3);
     CHECK(e.hi >= 0.45 - 1.0 / 3);
+}
+
+TEST_CASE("bounding balls are found at every scale, and hold the attractor", "[distance]") {
+    // {x/2 + t, x/2} on the x axis: the attractor is the segment [0, 2t], within 2t of any of its points.
+    // Translations from 1e-300 to 1e-15 and from 1e160 up were refused as "not contracting".
+    for (const double t :
+         {1e-300, 1e-200, 1e-100, 1e-16, 1e-15, 1e-12, 1.0, 1e12, 1e100, 1e160, 1e200, 1e300}) {
+        INFO("translation " << t);
+        const num::Rational half(1, 2), tr = num::Rational::from_double(t);
+        const ir::Automaton z = rt::test::ifs(
+            "z", {rt::test::affine2(half, 0, 0, half, tr, 0), rt::test::affine2(half, 0, 0, half, 0, 0)});
+        const std::vector<rt::StateBall> balls = rt::bounding_balls(z);
+        REQUIRE(balls.size() == 1);
+        const rt::StateBall& b = balls[0];
+        REQUIRE(std::isfinite(b.radius));
+        // Both ends of the segment lie in the ball (the distance from the centre, rounded up)...
+        for (const double x : {0.0, 2 * t}) {
+            const double dx = std::fabs(x - b.centre[0]), dy = std::fabs(b.centre[1]);
+            const double far = std::max(dx, dy), near = std::min(dx, dy);
+            CHECK(far * (1 + 1e-15) * std::sqrt(1 + (near / far) * (near / far)) <= b.radius);
+        }
+        // ... and the ball is not much larger than the segment.
+        CHECK(b.radius <= 4 * t);
+    }
+    // Maps that do not contract keep their message.
+    const num::Rational two(2), half(1, 2);
+    const ir::Automaton grows =
+        rt::test::ifs("grows", {rt::test::affine2(two, 0, 0, two, num::Rational::from_double(1e-16), 0),
+                                rt::test::affine2(half, 0, 0, half, 0, 0)});
+    CHECK_THROWS_WITH(rt::bounding_balls(grows),
+                      Catch::Contains("its operators do not contract in the euclidean norm"));
 }
