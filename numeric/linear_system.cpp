@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <set>
 
 namespace frac::num {
 
@@ -81,13 +82,20 @@ struct Row {
     std::map<std::size_t, Value> terms;
     std::vector<std::size_t> sources; // sorted, unique
 
-    // this += s * o, dropping the coefficients that become zero.
-    void add_scaled(const Row& o, const Value& s, const Field& field) {
+    // this += s * o, dropping the coefficients that become zero; `rows_with` (the rows each variable has
+    // a term in) gains this row, `self`, where a term appears and loses it where one is dropped.
+    void add_scaled(const Row& o, const Value& s, const Field& field, std::size_t self,
+                    std::vector<std::set<std::size_t>>& rows_with) {
         constant += o.constant * s;
         for (const auto& [v, a] : o.terms) {
             auto [it, inserted] = terms.emplace(v, a * s);
             if (!inserted) it->second += a * s;
-            if (field.is_zero(it->second)) terms.erase(it);
+            if (field.is_zero(it->second)) {
+                terms.erase(it);
+                if (!inserted) rows_with[v].erase(self);
+            } else if (inserted) {
+                rows_with[v].insert(self);
+            }
         }
     }
 };
@@ -127,12 +135,16 @@ Reduced<Field> reduce(const Field& field, const std::vector<LinearSystem::Equati
     }
     r.pivot_row.assign(variables, std::nullopt);
     std::vector<bool> is_pivot(r.rows.size(), false);
+    // The rows with a term in each variable, increasing, kept up to date through the fill-in: the pivot
+    // search and the elimination visit only those rows, not every row for every variable.
+    std::vector<std::set<std::size_t>> rows_with(variables);
+    for (std::size_t i = 0; i < r.rows.size(); ++i)
+        for (const auto& term : r.rows[i].terms) rows_with[term.first].insert(rows_with[term.first].end(), i);
     for (std::size_t v = variables; v-- > 0;) {
         std::optional<std::size_t> best;
-        for (std::size_t i = 0; i < r.rows.size(); ++i) {
+        for (std::size_t i : rows_with[v]) {
             if (is_pivot[i]) continue;
             const auto it = r.rows[i].terms.find(v);
-            if (it == r.rows[i].terms.end()) continue;
             if (!best || field.better(it->second, r.rows[i].terms.size(), r.rows[*best].terms.at(v),
                                       r.rows[*best].terms.size()))
                 best = i;
@@ -145,15 +157,15 @@ Reduced<Field> reduce(const Field& field, const std::vector<LinearSystem::Equati
         p.terms[v] = typename Field::Value(1);
         is_pivot[*best] = true;
         r.pivot_row[v] = *best;
-        for (std::size_t i = 0; i < r.rows.size(); ++i) {
+        const std::vector<std::size_t> with_v(rows_with[v].begin(), rows_with[v].end());
+        for (std::size_t i : with_v) {
             if (i == *best) continue;
-            auto it = r.rows[i].terms.find(v);
-            if (it == r.rows[i].terms.end()) continue;
-            const auto factor = -it->second;
-            r.rows[i].add_scaled(p, factor, field);
+            const auto factor = -r.rows[i].terms.at(v);
+            r.rows[i].add_scaled(p, factor, field, i, rows_with);
             r.rows[i].terms.erase(v); // exactly eliminated, whatever rounding left
             r.rows[i].sources = merged(r.rows[i].sources, p.sources);
         }
+        rows_with[v] = {*best}; // every term in v but the pivot's is gone
     }
     for (std::size_t i = 0; i < r.rows.size(); ++i)
         if (!is_pivot[i] && !field.is_zero(r.rows[i].constant)) {
