@@ -69,6 +69,139 @@ std::string letters(std::size_t k) {
     return s;
 }
 
+// The blocks of the most-uniform least-squares system (most_uniform_values): the free variables
+// (solution.free, by their column k) joined when an entry of a barycentric operator depends on both.
+struct UniformBlocks {
+    std::map<std::size_t, std::size_t> column;     // free variable -> its column k
+    std::vector<std::size_t> block, index;         // per column: its block and its index in the block
+    std::vector<std::vector<std::size_t>> members; // per block: its columns, increasing
+    // Per block: the size of the dense system least_squares solves for it, the number of its rows of
+    // several terms when that is smaller than the block and every column has a row of its own, else the
+    // block's size.
+    std::vector<std::size_t> dense;
+};
+
+UniformBlocks uniform_blocks(const BcifsSystem& sys, const BcifsSolution& sol) {
+    UniformBlocks out;
+    const std::size_t n = sol.free.size();
+    for (std::size_t k = 0; k < n; ++k) out.column[sol.free[k]] = k;
+    std::vector<std::size_t> parent(n);
+    for (std::size_t k = 0; k < n; ++k) parent[k] = k;
+    const auto root = [&](std::size_t k) {
+        while (parent[k] != k) k = parent[k] = parent[parent[k]];
+        return k;
+    };
+    for (std::size_t j = 0; j < sys.operators.size(); ++j) {
+        if (!sys.operators[j].barycentric) continue;
+        for (const AffineForm& f : sol.entries[j]) {
+            std::optional<std::size_t> first;
+            for (const auto& [v, a] : f.terms) {
+                const auto c = out.column.find(v);
+                if (c == out.column.end()) continue;
+                if (!first)
+                    first = root(c->second);
+                else if (const std::size_t r = root(c->second); r != *first)
+                    parent[r] = *first;
+            }
+        }
+    }
+    out.block.assign(n, 0);
+    out.index.assign(n, 0);
+    std::vector<std::optional<std::size_t>> block_of_root(n);
+    for (std::size_t k = 0; k < n; ++k) {
+        auto& b = block_of_root[root(k)];
+        if (!b) {
+            b = out.members.size();
+            out.members.emplace_back();
+        }
+        out.block[k] = *b;
+        out.index[k] = out.members[*b].size();
+        out.members[*b].push_back(k);
+    }
+    std::vector<std::size_t> several(out.members.size(), 0); // rows of several terms, per block
+    std::vector<bool> own(n, false);                         // the column has a row of one term
+    for (std::size_t j = 0; j < sys.operators.size(); ++j) {
+        if (!sys.operators[j].barycentric) continue;
+        for (const AffineForm& f : sol.entries[j]) {
+            std::size_t count = 0, last = 0;
+            for (const auto& term : f.terms)
+                if (const auto c = out.column.find(term.first); c != out.column.end()) {
+                    ++count;
+                    last = c->second;
+                }
+            if (count == 1) own[last] = true;
+            if (count > 1) ++several[out.block[last]];
+        }
+    }
+    out.dense.resize(out.members.size());
+    for (std::size_t b = 0; b < out.members.size(); ++b) {
+        const bool all_own =
+            std::all_of(out.members[b].begin(), out.members[b].end(), [&](std::size_t k) { return own[k]; });
+        out.dense[b] = all_own && several[b] < out.members[b].size() ? several[b] : out.members[b].size();
+    }
+    return out;
+}
+
+// A row of a least-squares system: sum over terms of coefficient * x_index ~ b.
+struct LeastSquaresRow {
+    std::vector<std::pair<std::size_t, Rational>> terms;
+    Rational b;
+};
+
+// The x minimising |A x - b| over `size` variables (0 when the normal equations are singular), exactly.
+// Dense: the normal equations (A^T A) x = A^T b. By rows (`woodbury`, when every variable has a row of
+// its own term): A^T A = D + C^T C with D diagonal (the rows of one term) and C the rows of several, so
+// x = y - D^-1 C^T z with y = D^-1 A^T b and (I + C D^-1 C^T) z = C y (the Woodbury identity), a dense
+// system as large as C has rows, not as the block (one row for a column summing to 1 with the rest).
+std::vector<Rational> least_squares(const std::vector<LeastSquaresRow>& rows, std::size_t size,
+                                    bool woodbury) {
+    std::vector<Rational> rhs(size);
+    for (const LeastSquaresRow& row : rows)
+        for (const auto& [i, a] : row.terms) rhs[i] += a * row.b;
+    if (!woodbury) {
+        num::Matrix<Rational> normal(size, size), r(size, 1);
+        for (std::size_t i = 0; i < size; ++i) r(i, 0) = rhs[i];
+        for (const LeastSquaresRow& row : rows)
+            for (const auto& [i, ai] : row.terms)
+                for (const auto& [k, ak] : row.terms) normal(i, k) += ai * ak;
+        const auto x = num::solve(normal, r);
+        std::vector<Rational> out(size);
+        for (std::size_t i = 0; x && i < size; ++i) out[i] = (*x)(i, 0);
+        return out;
+    }
+    std::vector<Rational> diagonal(size);
+    std::vector<const LeastSquaresRow*> several;
+    for (const LeastSquaresRow& row : rows) {
+        if (row.terms.size() == 1)
+            diagonal[row.terms[0].first] += row.terms[0].second * row.terms[0].second;
+        else
+            several.push_back(&row);
+    }
+    std::vector<Rational> x(size);
+    for (std::size_t i = 0; i < size; ++i) x[i] = rhs[i] / diagonal[i];
+    const std::size_t d = several.size();
+    if (d == 0) return x; // A^T A is diagonal
+    num::Matrix<Rational> s(d, d), cy(d, 1);
+    std::vector<Rational> scaled(size); // row p of C D^-1, scattered
+    for (std::size_t p = 0; p < d; ++p) {
+        for (const auto& [i, a] : several[p]->terms) {
+            scaled[i] = a / diagonal[i];
+            cy(p, 0) += a * x[i];
+        }
+        for (std::size_t q = 0; q < d; ++q) {
+            Rational sum(p == q ? 1 : 0);
+            for (const auto& [i, a] : several[q]->terms) sum += a * scaled[i];
+            s(p, q) = sum;
+        }
+        for (const auto& term : several[p]->terms) scaled[term.first] = Rational(0);
+    }
+    const auto z = num::solve(s, cy);
+    if (!z) return std::vector<Rational>(size);
+    for (std::size_t p = 0; p < d; ++p)
+        for (const auto& [i, a] : several[p]->terms) x[i] -= a * (*z)(p, 0) / diagonal[i];
+    return x;
+}
+
 } // namespace
 
 std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& sys, Diagnostics& diags) {
@@ -259,18 +392,20 @@ std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& sys, Diagnostics& di
         }
         out.variable_names[v] = fmt::format("{}{}", group[key], origin[v].row);
     }
-    // Degrees of freedom: a free entry belongs to the lowest cell whose operators use it.
+    // Degrees of freedom: a free entry belongs to the lowest cell whose operators use it (the first such
+    // operator's cell on a tie), found in one pass over the entries.
     out.dof.assign(sys.cells.size(), 0);
-    for (std::size_t v : out.free) {
-        std::optional<std::size_t> owner;
-        for (std::size_t j = 0; j < sys.operators.size(); ++j) {
-            const std::size_t cell = sys.operators[j].cell_index;
-            const bool uses = std::any_of(out.entries[j].begin(), out.entries[j].end(),
-                                          [&](const AffineForm& e) { return e.terms.count(v) > 0; });
-            if (uses && (!owner || sys.cell_order[cell] < sys.cell_order[*owner])) owner = cell;
-        }
-        if (owner) ++out.dof[*owner];
+    std::vector<std::optional<std::size_t>> owner(variables);
+    for (std::size_t j = 0; j < sys.operators.size(); ++j) {
+        const std::size_t cell = sys.operators[j].cell_index;
+        for (const AffineForm& e : out.entries[j])
+            for (const auto& [v, a] : e.terms) {
+                auto& o = owner[v];
+                if (!o || sys.cell_order[cell] < sys.cell_order[*o]) o = cell;
+            }
     }
+    for (std::size_t v : out.free)
+        if (owner[v]) ++out.dof[*owner[v]];
     return out;
 }
 
@@ -278,37 +413,40 @@ std::vector<Rational> most_uniform_values(const BcifsSystem& sys, const BcifsSol
                                           const std::vector<Rational>& params) {
     const std::size_t n = sol.free.size();
     if (n == 0) return {};
-    std::map<std::size_t, std::size_t> column; // free variable -> its column in the least-squares system
-    for (std::size_t k = 0; k < n; ++k) column[sol.free[k]] = k;
-    // Normal equations (A^T A) x = A^T b, accumulated entry by entry: each entry is a row of A.
-    num::Matrix<Rational> normal(n, n), rhs(n, 1);
+    // Least squares: each entry of a barycentric operator is a row of A (its free variables' coefficients)
+    // and of b (1/rows less the rest); the rows are kept by block, in the block's own indices.
+    const UniformBlocks blocks = uniform_blocks(sys, sol);
+    std::vector<std::vector<LeastSquaresRow>> rows(blocks.members.size());
     for (std::size_t j = 0; j < sys.operators.size(); ++j) {
         const auto& op = sys.operators[j];
         if (!op.barycentric) continue;
         const Rational target(1, static_cast<long>(op.rows));
         for (const AffineForm& f : sol.entries[j]) {
-            std::vector<std::pair<std::size_t, Rational>> row;
-            Rational b = target - f.constant;
+            LeastSquaresRow row;
+            std::size_t block = 0;
+            row.b = target - f.constant;
             for (const auto& [v, a] : f.terms) {
-                if (auto c = column.find(v); c != column.end())
-                    row.emplace_back(c->second, a);
-                else
-                    b -= a * params[v];
+                if (auto c = blocks.column.find(v); c != blocks.column.end()) {
+                    block = blocks.block[c->second];
+                    row.terms.emplace_back(blocks.index[c->second], a);
+                } else {
+                    row.b -= a * params[v];
+                }
             }
-            for (const auto& [i, ai] : row) {
-                rhs(i, 0) += ai * b;
-                for (const auto& [k, ak] : row) normal(i, k) += ai * ak;
-            }
+            if (!row.terms.empty()) rows[block].push_back(std::move(row));
         }
     }
-    // Every free variable is an entry of its own (a row of A with one 1), so A^T A is invertible.
-    const auto x = num::solve(normal, rhs);
     std::vector<Rational> out(n);
-    for (std::size_t k = 0; k < n; ++k) {
-        const mpq_class scaled = (x ? (*x)(k, 0).value() : mpq_class(0)) * 64 + mpq_class(1, 2);
-        mpz_class whole;
-        mpz_fdiv_q(whole.get_mpz_t(), scaled.get_num_mpz_t(), scaled.get_den_mpz_t());
-        out[k] = Rational(mpq_class(whole, 64));
+    for (std::size_t b = 0; b < blocks.members.size(); ++b) {
+        const std::vector<Rational> x =
+            least_squares(rows[b], blocks.members[b].size(), blocks.dense[b] < blocks.members[b].size());
+        rows[b] = {};
+        for (std::size_t i = 0; i < blocks.members[b].size(); ++i) {
+            const mpq_class scaled = x[i].value() * 64 + mpq_class(1, 2);
+            mpz_class whole;
+            mpz_fdiv_q(whole.get_mpz_t(), scaled.get_num_mpz_t(), scaled.get_den_mpz_t());
+            out[blocks.members[b][i]] = Rational(mpq_class(whole, 64));
+        }
     }
     return out;
 }

@@ -79,7 +79,9 @@ std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& system, Diagnostics&
 
 // Values of the free entries (solution.free, in order) that make the operators the most uniform: the
 // least-squares choice of every entry of a barycentric operator closest to 1/rows (so columns spread
-// their weight, which tends to contract), rounded to multiples of 1/64 (exact and short to print).
+// their weight, which tends to contract), rounded to multiples of 1/64 (exact and short to print). The
+// normal equations are solved exactly per block of free entries that some entry ties together (a column
+// of an operator, typically), each as a dense system no larger than the block's entries of several terms.
 // `params` holds the parameters' values (the first system.params.size() variables).
 std::vector<num::Rational> most_uniform_values(const BcifsSystem& system, const BcifsSolution& solution,
                                                const std::vector<num::Rational>& params);
