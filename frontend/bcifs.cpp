@@ -1,8 +1,11 @@
 #include "frontend/bcifs.hpp"
+#include "frontend/limits.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <initializer_list>
 #include <map>
 
 namespace frac::front {
@@ -67,6 +70,18 @@ std::string letters(std::size_t k) {
         k /= 26;
     } while (k-- > 0);
     return s;
+}
+
+std::uint64_t saturating_sum(std::uint64_t a, std::uint64_t b) {
+    std::uint64_t s = 0;
+    return __builtin_add_overflow(a, b, &s) ? UINT64_MAX : s;
+}
+
+std::uint64_t saturating_product(std::initializer_list<std::uint64_t> factors) {
+    std::uint64_t p = 1;
+    for (std::uint64_t f : factors)
+        if (__builtin_mul_overflow(p, f, &p)) return UINT64_MAX;
+    return p;
 }
 
 // The blocks of the most-uniform least-squares system (most_uniform_values): the free variables
@@ -204,7 +219,8 @@ std::vector<Rational> least_squares(const std::vector<LeastSquaresRow>& rows, st
 
 } // namespace
 
-std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& sys, Diagnostics& diags) {
+std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& sys, Diagnostics& diags,
+                                         std::uint64_t max_dense) {
     // Variables: the parameters, then each operator's unknown entries column by column.
     std::vector<Forms> forms(sys.operators.size());
     struct Origin {
@@ -406,6 +422,21 @@ std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& sys, Diagnostics& di
     }
     for (std::size_t v : out.free)
         if (owner[v]) ++out.dof[*owner[v]];
+    // The dense systems most_uniform_values will solve, refused before it builds them when over the limit.
+    const UniformBlocks blocks = uniform_blocks(sys, out);
+    std::uint64_t cubes = 0;
+    for (std::size_t m : blocks.dense) cubes = saturating_sum(cubes, saturating_product({m, m, m}));
+    if (cubes > max_dense) {
+        diags.error(sys.loc,
+                    fmt::format("bcifs '{}' is too large to give its {} free entries values: the most "
+                                "uniform values solve exact dense systems of up to {} unknowns, their "
+                                "sizes cubed summing to {}, more than the limit of {}{}; fix some of the "
+                                "free entries (frac solve shows them), or split its cells into fewer parts",
+                                sys.name, out.free.size(),
+                                *std::max_element(blocks.dense.begin(), blocks.dense.end()), cubes, max_dense,
+                                raised_by("FRAC_MAX_BCIFS_DENSE")));
+        return std::nullopt;
+    }
     return out;
 }
 

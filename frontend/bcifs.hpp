@@ -17,6 +17,7 @@
 #include "numeric/matrix.hpp"
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -58,6 +59,7 @@ struct BcifsSystem {
     // tolerance (numeric/linear_system.hpp); `inexact_at` is the first such entry.
     std::optional<double> tolerance;
     Location inexact_at;
+    Location loc; // the bcifs, for its limits
 };
 
 struct BcifsSolution {
@@ -74,8 +76,11 @@ struct BcifsSolution {
 };
 
 // Solves the system; errors (a conflict with its minimal set of constraints, a product that stays
-// bilinear) go to `diags` and give nullopt.
-std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& system, Diagnostics& diags);
+// bilinear) go to `diags` and give nullopt. So does a solution whose free entries most_uniform_values
+// would give values by dense exact systems whose sizes cubed sum to more than `max_dense`
+// (Limits::max_bcifs_dense), reported before they are built.
+std::optional<BcifsSolution> solve_bcifs(const BcifsSystem& system, Diagnostics& diags,
+                                         std::uint64_t max_dense = UINT64_MAX);
 
 // Values of the free entries (solution.free, in order) that make the operators the most uniform: the
 // least-squares choice of every entry of a barycentric operator closest to 1/rows (so columns spread

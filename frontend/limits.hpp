@@ -22,6 +22,14 @@ struct Limits {
     std::uint64_t max_inline_nodes = 2'000'000;
     int max_import_depth = 64;                          // files open at once along a chain of imports
     std::size_t max_file_bytes = std::size_t{16} << 20; // of a model file (FRAC_MAX_FILE_MB, in MiB)
+    // Unknown entries of a bcifs's operators (FRAC_MAX_BCIFS_UNKNOWNS), counted by the type checker before
+    // anything is built: solving and choosing values take about 25 us and 1.5 KB per unknown entry
+    // (quad(e) split 7 x 7 over bary(7): 117,992, 2 s and 190 MB; split 8 x 8 over bary(8): 262,656).
+    std::uint64_t max_bcifs_unknowns = 131'072;
+    // The exact dense systems that give a bcifs's free entries their most uniform values, as the sum of
+    // their sizes cubed (FRAC_MAX_BCIFS_DENSE), counted before they are built (bcifs.hpp): 2 * 10^7 steps
+    // of exact arithmetic take a few seconds.
+    std::uint64_t max_bcifs_dense = 20'000'000;
 };
 
 // "(NAME raises it)", the end of a limit's message.

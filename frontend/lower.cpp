@@ -958,6 +958,7 @@ private:
         const BcifsDecl& b = *decl.bcifs;
         BcifsSystem sys;
         sys.name = it.name;
+        sys.loc = it.loc;
         for (const ParamDecl& p : b.params) sys.params.push_back(p.name);
         for (const StateDecl& s : decl.states) {
             sys.cells.push_back(s.name);
@@ -1044,7 +1045,7 @@ private:
         const AutomatonDecl& decl = *it.automaton;
         const BcifsDecl& b = *decl.bcifs;
         const BcifsSystem sys = bcifs_system(it, index);
-        const std::optional<BcifsSolution> sol = solve_bcifs(sys, d_);
+        const std::optional<BcifsSolution> sol = solve_bcifs(sys, d_, limits_.max_bcifs_dense);
         if (!sol) throw AlreadyReported{};
         std::vector<num::Rational> values(sol->variable_names.size());
         std::vector<std::size_t> chosen; // the variables the compiler gave values

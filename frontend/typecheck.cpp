@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <tuple>
 #include <unordered_set>
 
 namespace frac::front {
@@ -39,7 +40,8 @@ struct Closure {
 class Checker : Inliner<TValue> {
 public:
     Checker(const Program& p, const Limits& limits, TypedProgram& out, Diagnostics& d)
-        : Inliner(limits.max_inline_depth), p_(p), out_(out), d_(d) {}
+        : Inliner(limits.max_inline_depth), p_(p), out_(out), d_(d),
+          max_bcifs_unknowns_(limits.max_bcifs_unknowns) {}
 
     void run() {
         for (const Item& it : p_.items)
@@ -488,7 +490,7 @@ private:
             if (arc.probability)
                 require_number(closed(*arc.probability, Context::constant).type, arc.probability->loc);
         }
-        if (a.bcifs) check_bcifs(a, state);
+        if (a.bcifs) check_bcifs(it, a, state);
         const StateDecl& initial = initial_state(a);
         if (a.projection) {
             const Type p = closed(*a.projection, Context::constant).type;
@@ -515,7 +517,7 @@ private:
     // The operators' sizes follow from the cells' spaces; every constraint's products are defined and
     // both sides have one size; the entries and fixed values are numbers (the parameters are numbers).
     template <class State>
-    void check_bcifs(const AutomatonDecl& a, const State& state) {
+    void check_bcifs(const Item& it, const AutomatonDecl& a, const State& state) {
         const BcifsDecl& b = *a.bcifs;
         for (const ParamDecl& p : b.params)
             for (const Expr* e : {p.lo.get(), p.hi.get(), p.value.get()})
@@ -587,6 +589,49 @@ private:
                 fail(c.loc, fmt::format("the two sides of this constraint differ in size: {}×{} and {}×{}",
                                         sides[0].first, sides[0].second, sides[1].first, sides[1].second));
         }
+        check_bcifs_size(it, a, size_of);
+    }
+
+    // The solver (frontend/bcifs.hpp) builds and solves a linear system with an unknown per unknown entry
+    // of the operators, and its work and memory grow with their number: more than the limit
+    // (Limits::max_bcifs_unknowns) is refused before anything is built, at the bcifs, with a note at the
+    // declaration whose operators have the most of them (a topology's split, usually). Every count is a
+    // product of two sizes below 2^16 summed over the model's operators, far from 2^64.
+    template <class SizeOf>
+    void check_bcifs_size(const Item& it, const AutomatonDecl& a, const SizeOf& size_of) {
+        std::uint64_t unknowns = 0;
+        // Unknown entries per declaration (file, line, column): a topology's operators share its location.
+        std::map<std::tuple<std::uint32_t, std::uint32_t, std::uint32_t>, std::pair<Location, std::uint64_t>>
+            by_declaration;
+        for (const OperatorDecl& op : a.bcifs->operators) {
+            const auto [rows, cols] = size_of(op);
+            std::uint64_t unknown = 0;
+            if (!op.value && op.source.empty())
+                unknown = static_cast<std::uint64_t>(rows) * static_cast<std::uint64_t>(cols);
+            else if (op.value && op.value->kind == ExprKind::matrix)
+                for (const ExprPtr& row : op.value->kids)
+                    for (const ExprPtr& entry : row->kids) unknown += is_unknown(*entry) ? 1 : 0;
+            if (unknown == 0) continue;
+            unknowns += unknown;
+            auto& d = by_declaration[{op.loc.file, op.loc.line, op.loc.column}];
+            d.first = op.loc;
+            d.second += unknown;
+        }
+        if (unknowns <= max_bcifs_unknowns_) return;
+        CompileError e(it.loc,
+                       fmt::format("bcifs '{}' has {} unknown entries to solve for, more than the limit "
+                                   "of {}{}; split its cells into fewer parts or give them fewer "
+                                   "control points (a smaller bary(n))",
+                                   it.name, unknowns, max_bcifs_unknowns_,
+                                   raised_by("FRAC_MAX_BCIFS_UNKNOWNS")));
+        const auto most =
+            std::max_element(by_declaration.begin(), by_declaration.end(),
+                             [](const auto& x, const auto& y) { return x.second.second < y.second.second; });
+        if (most != by_declaration.end())
+            e.notes.emplace_back(
+                most->second.first,
+                fmt::format("{} of them are entries of the operators declared here", most->second.second));
+        throw e;
     }
 
     // An entry of an operator or a fixed value: a constant in which the bcifs's parameters are numbers.
@@ -742,6 +787,7 @@ private:
     const Program& p_;
     TypedProgram& out_;
     Diagnostics& d_;
+    std::uint64_t max_bcifs_unknowns_;
     std::unordered_map<std::string, const Item*> globals_;
     std::unordered_set<const Item*> in_progress_, failed_;
     std::map<InstanceKey, Type> checked_;
