@@ -274,6 +274,10 @@ int render_automaton(const front::AutomatonInfo& info, const RenderOptions& o) {
     }
     if (!o.slice.empty() && method != "cover")
         throw UsageError("--slice draws a section of a cover: give --method cover");
+    if (!o.box.empty())
+        throw UsageError(fmt::format("--box sets the view of a shape's cover; '{}' is an automaton, drawn "
+                                     "over the bounds of its attractor",
+                                     info.name));
     if (method == "chaos" && ends_with(o.output, ".svg"))
         throw UsageError("--method chaos draws a .png; .svg is for --method tree or cover");
     if (method == "tree") {

@@ -347,6 +347,9 @@ int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions&
     if (!c) return front::exit_compile_error;
     const FreedAtExit keep_model(c);
     if (const front::AutomatonInfo* a = c->module.find_automaton(o.shape)) return mesh_automaton(*a, o);
+    if (!o.layout.empty() || !o.cells.empty())
+        throw UsageError("--layout and --cells cut the initial state of an automaton; a shape is meshed from "
+                         "its cover");
     if (ends_with(o.output, ".svg"))
         throw UsageError("a shape is meshed as .stl, .obj or .ply; .svg is for the curves of automata");
     const front::ShapeInfo& s = pick_shape(*c, o.shape);
