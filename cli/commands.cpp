@@ -346,7 +346,8 @@ int run_mesh(const std::string& file, const MeshOptions& o, const EngineOptions&
     auto c = compile_or_report(file);
     if (!c) return front::exit_compile_error;
     const FreedAtExit keep_model(c);
-    if (const front::AutomatonInfo* a = c->module.find_automaton(o.shape)) return mesh_automaton(*a, o);
+    if (const front::AutomatonInfo* a = c->module.find_automaton(o.shape))
+        return on_automaton(*c, *a, [&] { return mesh_automaton(*a, o); });
     if (!o.layout.empty() || !o.cells.empty())
         throw UsageError("--layout and --cells cut the initial state of an automaton; a shape is meshed from "
                          "its cover");

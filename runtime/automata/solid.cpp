@@ -249,6 +249,7 @@ SolidMesh tessellate_solid(const ir::Automaton& a, int depth) {
                 result.mesh.triangles.push_back({use(t[0]), use(t[1]), use(t[2])});
     }
     orient(result.mesh);
+    require_finite_vertices(result.mesh.vertices);
     return result;
 }
 

@@ -2,6 +2,7 @@
 
 #include "ir/automaton_check.hpp"
 #include "runtime/automata/points.hpp"
+#include "runtime/limits.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -512,7 +513,15 @@ Tessellation tessellate(const ir::Automaton& a, const SurfaceLayout& layout, int
     walk(walk, layout.root, 0, Frame{{0, 0}, {{1, 0}, {0, 1}}});
     if (std::find(written.begin(), written.end(), 0) != written.end())
         throw std::logic_error("tessellate: a grid vertex was not reached");
+    require_finite_vertices(t.vertices);
     return t;
+}
+
+void require_finite_vertices(const std::vector<std::array<double, 3>>& vertices) {
+    for (const std::array<double, 3>& v : vertices)
+        if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2])))
+            throw RangeError("the tessellation leaves the range of doubles (a vertex is not finite): scale "
+                             "the model's coordinates down");
 }
 
 Mesh surface_mesh(const Tessellation& t) {
@@ -747,6 +756,7 @@ Mesh tessellate_triangle_patch(const ir::Automaton& a, const ir::TrianglePatch& 
                 descend(patch.down[k++], (c + 1) * child, b * child, true);
     };
     walk(walk, 0, side, Frame{{0, 0}, {{1, 0}, {0, 1}}});
+    require_finite_vertices(mesh.vertices);
     return mesh;
 }
 

@@ -87,6 +87,10 @@ Tessellation tessellate(const ir::Automaton& a, const SurfaceLayout& layout, int
 // Two triangles per grid square, counter-clockwise around ds x dt. Throws for a curve.
 Mesh surface_mesh(const Tessellation& t);
 
+// Throws RangeError when a vertex is not finite: the model's values leave the range of doubles (a fault
+// of the model, reported at the automaton), which no mesh or picture file can hold.
+void require_finite_vertices(const std::vector<std::array<double, 3>>& vertices);
+
 // A triangle patch (ir::TrianglePatch, the automaton's initial state) tessellated to depth p: the
 // (N + 1)(N + 2) / 2 vertices of its grid, N = n^p, each computed once from the first sub-triangle that
 // reaches it (so shared sides are bit-identical), and its n^(2p) triangles, counter-clockwise in the
