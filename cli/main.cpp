@@ -273,6 +273,7 @@ int run(int argc, char** argv) {
     tree->add_option("-o,--output", tree_options.output,
                      "picture file: .png or .svg (curves as polylines); without it the tree is printed");
     tree->add_option("--size", tree_options.size, "picture width and height in pixels")
+        ->check(CLI::Range(16, 16384))
         ->capture_default_str();
     tree->add_flag("--force", tree_options.force, "write an SVG estimated above 100 MB");
     tree->add_option("--max-cells", tree_options.limits.cells,

@@ -883,7 +883,7 @@ private:
             if (e.op == Tok::slash && b.is_constant() && !b.constant.is_zero())
                 return a * (num::Rational(1) / b.constant);
         }
-        fail(e.loc, "an entry is affine in the parameters: sums of parameters times numbers");
+        fail(e.loc, "an entry must be affine in the parameters: a sum of parameters times numbers");
     }
 
     // The solved operator `d.source`.`d.source_cell`.`d.name` of a cell taken from another bcifs
