@@ -50,8 +50,10 @@ struct RssOptions {
     int split = 2;          // parts per axis and level
     bool keep_cells = true; // record every evaluated cell (for pictures); false keeps only counts
     // Cells per eval_boxes call (>= 1); once cells prune, a batch ends before the children of a parent
-    // row it would cut (a parent's children stay together).
-    std::size_t batch = 4096;
+    // row it would cut (a parent's children stay together). With several threads a batch holds this
+    // many cells per thread, cut into chunks. Each batch costs a hand-over and a wait; with 4096 they
+    // took 3-4% of a depth-12 carpet cover on two threads (docs/performance.md).
+    std::size_t batch = 16384;
     RssProgress progress; // optional
     // Threads evaluating each batch (0: all cores). Each thread has its own clone of the evaluator,
     // and results are placed by cell position, so the output is the same for every thread count.
