@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -14,6 +15,34 @@
 namespace frac::rt {
 
 namespace {
+
+// x * 2^-p rounded down (dir = -inf) or up (dir = +inf): exact unless the result is subnormal.
+double scale_down(double x, int p, double dir) {
+    const double y = std::ldexp(x, -p);
+    return std::ldexp(y, p) == x ? y : std::nextafter(y, dir);
+}
+
+// The Euclidean norm of the vectors in the d <= 3 intervals v (under upward rounding). Components
+// past 2^500 are scaled down by a power of two first, so that no square overflows (a point 1e160
+// away had the distance [1.3e154, inf]); the scaling is exact for every component that stays a
+// normal double, and the others are rounded outward.
+Interval euclidean_norm(const Interval* v, std::size_t d) {
+    double largest = 0;
+    for (std::size_t i = 0; i < d; ++i) largest = std::max({largest, std::fabs(v[i].lo), std::fabs(v[i].hi)});
+    Interval sum(0.0);
+    if (!(largest > 0x1p500)) {
+        for (std::size_t i = 0; i < d; ++i) sum = num::add(sum, num::sqr(v[i]));
+        return num::sqrt(sum);
+    }
+    const int p = std::isinf(largest) ? 1023 : std::ilogb(largest);
+    for (std::size_t i = 0; i < d; ++i)
+        sum = num::add(
+            sum, num::sqr(Interval(scale_down(v[i].lo, p, -num::inf), scale_down(v[i].hi, p, num::inf))));
+    const Interval r = num::sqrt(sum);
+    // Back to scale: exact, or past the largest double (an upper bound of infinity, a lower one of
+    // the largest double).
+    return Interval(std::min(std::ldexp(r.lo, p), std::numeric_limits<double>::max()), std::ldexp(r.hi, p));
+}
 
 using bounds::down_sub;
 using bounds::frobenius_upper;
@@ -234,25 +263,23 @@ DistanceResult AttractorDistance::query(const Interval* box) const {
         const StateBall& ball = balls_[node.state];
         const std::size_t n = states_[node.state].coords;
         const Interval* m = &pool[node.slot * stride];
-        Interval dist2(0.0), wmax2(0.0);
-        double wmin2 = 0;
+        Interval to_centre[3], to_witness[3], outside[3];
         for (std::size_t i = 0; i < d; ++i) {
             Interval ci(0.0), wi(0.0);
             for (std::size_t j = 0; j < n; ++j) {
                 ci = num::add(ci, num::mul(m[i * n + j], Interval(ball.centre[j])));
                 wi = num::add(wi, num::mul(m[i * n + j], ball.witness[j]));
             }
-            dist2 = num::add(dist2, num::sqr(num::sub(box[i], ci)));
-            wmax2 = num::add(wmax2, num::sqr(num::sub(box[i], wi)));
+            to_centre[i] = num::sub(box[i], ci);
+            to_witness[i] = num::sub(box[i], wi);
             // The most any point of the witness's box can lie outside the box along this axis.
-            const double e = std::max({0.0, num::sub(Interval(wi.hi), Interval(box[i].hi)).hi,
-                                       num::sub(Interval(box[i].lo), Interval(wi.lo)).hi});
-            wmin2 = up_add(wmin2, up_mul(e, e));
+            outside[i] = Interval(std::max({0.0, num::sub(Interval(wi.hi), Interval(box[i].hi)).hi,
+                                            num::sub(Interval(box[i].lo), Interval(wi.lo)).hi}));
         }
         const double slack = up_mul(node.lip, ball.witness_radius);
-        best_min = std::min(best_min, up_add(num::sqrt(Interval(wmin2)).hi, slack));
-        best_max = std::min(best_max, up_add(num::sqrt(wmax2).hi, slack));
-        return down_sub(num::sqrt(dist2).lo, up_mul(node.lip, ball.radius));
+        best_min = std::min(best_min, up_add(euclidean_norm(outside, d).hi, slack));
+        best_max = std::min(best_max, up_add(euclidean_norm(to_witness, d).hi, slack));
+        return down_sub(euclidean_norm(to_centre, d).lo, up_mul(node.lip, ball.radius));
     };
     // The child of `node` along `arc`: its composite M T and Lipschitz bound (not yet evaluated).
     std::vector<Interval> lin;
@@ -321,8 +348,12 @@ DistanceResult AttractorDistance::query(const Interval* box) const {
     std::vector<Node> heap{root};
     auto later = [](const Node& a, const Node& b) { return a.lower > b.lower; };
     double pruned_min = num::inf; // least lower bound of a pruned node
+    // Epsilon, or a few units in the last place of the distance where that is coarser: far from the
+    // attractor (1e10 and beyond, for the default 1e-6) no bound can come closer than the rounding,
+    // and each query ran to the node budget (a point 1e200 away took 1.2 s).
+    const auto tolerance = [&] { return best_min < num::inf ? std::max(eps, best_min * 0x1p-50) : eps; };
     while (!heap.empty()) {
-        if (heap.front().lower >= best_min - eps) {
+        if (heap.front().lower >= best_min - tolerance()) {
             result.converged = true;
             break;
         }
@@ -335,7 +366,7 @@ DistanceResult AttractorDistance::query(const Interval* box) const {
             Node c = make_child(node, arcs_[ai]);
             c.lower = evaluate(c);
             // Nodes within epsilon of the best bound cannot narrow the result below epsilon.
-            if (c.lower >= best_min - eps) {
+            if (c.lower >= best_min - tolerance()) {
                 pruned_min = std::min(pruned_min, c.lower);
                 ++result.pruned;
                 free_slots.push_back(c.slot);

@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <random>
 #include <set>
@@ -241,6 +242,36 @@ TEST_CASE("bad automata give clear errors, odd queries safe answers", "[distance
     const num::Interval wide[2] = {{0, num::inf}, {0, 1}}, none[2] = {num::Interval::empty(), {0, 1}};
     CHECK(d.eval_box(wide) == num::Interval(0.0, num::inf));
     CHECK(d.eval_box(none).is_empty());
+}
+
+TEST_CASE("far points: tight enclosures up to the largest double and beyond", "[distance]") {
+    // The Sierpinski triangle lies in the unit square, so the distance from p lies within sqrt(2) of
+    // |p|. Far points once had squares overflowing: [1.3e154, inf] from 1e160 away.
+    const rt::AttractorDistance d(rt::test::sierpinski());
+    const long double reach = std::sqrt(2.0L);
+    const double directions[][2] = {{1, 0}, {0, -1}, {-0.6, 0.8}, {0.3, 0.4}};
+    for (int k = 0; k <= 1023; k += 11)
+        for (const auto& u : directions) {
+            const double p[2] = {std::ldexp(u[0], k), std::ldexp(u[1], k)};
+            const long double norm =
+                std::hypot(static_cast<long double>(p[0]), static_cast<long double>(p[1]));
+            INFO("2^" << k << " (" << u[0] << ", " << u[1] << ")");
+            const num::Interval e = d.eval_point(p);
+            CHECK(e.lo <= norm + reach);
+            CHECK(e.hi >= norm - reach);
+            CHECK(e.hi - e.lo <= 1e-12 * static_cast<double>(norm) + 1e-5);
+            // Past 2^40 the search stops within a few ulps of the distance: epsilon (1e-6) is below
+            // the rounding there, and such queries ran to the node budget. (Nearer, from below the
+            // triangle, the whole lower edge lies within epsilon of the nearest distance: the search
+            // may end at the budget, its result still proven.)
+            const num::Interval box[2] = {num::Interval(p[0]), num::Interval(p[1])};
+            if (k >= 40) CHECK(d.query(box).converged);
+        }
+    // Past the largest double: from the largest double (to a rounding) to infinity.
+    const double beyond[2] = {1.5e308, -1.5e308};
+    const num::Interval e = d.eval_point(beyond);
+    CHECK(e.lo >= std::nextafter(std::numeric_limits<double>::max(), 0.0) / (1 + 1e-15));
+    CHECK(e.hi == num::inf);
 }
 
 TEST_CASE("distances in R3 and from several threads", "[distance]") {
