@@ -80,6 +80,7 @@ front::Limits frontend_limits() {
     limit_from_env("FRAC_MAX_IMPORT_DEPTH", "files", 10000, l.max_import_depth);
     limit_from_env("FRAC_MAX_BCIFS_UNKNOWNS", "unknown entries", 1e12, l.max_bcifs_unknowns);
     limit_from_env("FRAC_MAX_BCIFS_DENSE", "steps", 1e18, l.max_bcifs_dense);
+    limit_from_env("FRAC_MAX_BCIFS_PROOF_WORK", "steps", 1e18, l.max_bcifs_proof_work);
     std::size_t mib = l.max_file_bytes >> 20;
     limit_from_env("FRAC_MAX_FILE_MB", "MiB", 1 << 20, mib);
     l.max_file_bytes = mib << 20;

@@ -31,7 +31,7 @@ void set_free_entry_seed(std::optional<std::uint64_t> seed);
 // The frontend's limits (frontend/limits.hpp), each raised or lowered by its environment variable
 // (FRAC_MAX_NESTING, FRAC_MAX_OPERATORS, FRAC_MAX_CALL_DEPTH, FRAC_MAX_SERIES_NESTING,
 // FRAC_MAX_SERIES_TERMS, FRAC_MAX_INLINE_NODES, FRAC_MAX_IMPORT_DEPTH, FRAC_MAX_FILE_MB,
-// FRAC_MAX_BCIFS_UNKNOWNS, FRAC_MAX_BCIFS_DENSE); a UsageError
+// FRAC_MAX_BCIFS_UNKNOWNS, FRAC_MAX_BCIFS_DENSE, FRAC_MAX_BCIFS_PROOF_WORK); a UsageError
 // when one is not a number in its range.
 front::Limits frontend_limits();
 // The most instructions of compiled code: 20,000, or FRAC_MAX_COMPILE_INSTRUCTIONS (at most 10^9).

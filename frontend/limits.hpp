@@ -30,6 +30,12 @@ struct Limits {
     // their sizes cubed (FRAC_MAX_BCIFS_DENSE), counted before they are built (bcifs.hpp): 2 * 10^7 steps
     // of exact arithmetic take a few seconds.
     std::uint64_t max_bcifs_dense = 20'000'000;
+    // The contraction proofs of a bcifs's value choices together (the most uniform values, then up to
+    // 7 nearby, or 64 draws from a seed), in products of their interval matrices times the matrices'
+    // size cubed (FRAC_MAX_BCIFS_PROOF_WORK): a choice is tried while a whole proof's budget is left
+    // (5 * 10^7, about a second). An edge over bary(40) that no choice makes contractive took 9 s to
+    // refuse, 72 s with a seed; small systems take a tiny part of it per proof.
+    std::uint64_t max_bcifs_proof_work = 100'000'000;
 };
 
 // "(NAME raises it)", the end of a limit's message.

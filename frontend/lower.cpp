@@ -1080,7 +1080,17 @@ private:
         const bool seeded = seed && !sol->free.empty();
         const int attempts = sol->free.empty() ? 1 : seeded ? 64 : 8;
         bool contracts = false;
-        for (int attempt = 0; attempt < attempts && !contracts; ++attempt) {
+        // The proofs' work, shared by the attempts (Limits::max_bcifs_proof_work): each attempt gets a
+        // whole proof's budget, or none is made.
+        double proof_work_left = static_cast<double>(limits_.max_bcifs_proof_work);
+        const double per_proof = std::min(ir::ContractivityOptions{}.max_work, proof_work_left);
+        int tried = 0;              // choices whose proof ran
+        bool out_of_budget = false; // the limit stopped the search
+        for (int attempt = 0; attempt < attempts && !contracts && !out_of_budget; ++attempt) {
+            if (attempts > 1 && proof_work_left < per_proof) {
+                out_of_budget = true;
+                break;
+            }
             for (std::size_t k = 0; k < sol->free.size(); ++k)
                 values[sol->free[k]] =
                     uniform[k] + (seeded         ? num::Rational(static_cast<long>(next() % 33) - 16, 64)
@@ -1111,21 +1121,42 @@ private:
                     info.arc_locs.push_back(o.loc);
                 }
             }
-            contracts = attempts == 1 || ir::prove_contractive(a).proven;
+            if (attempts == 1) {
+                contracts = true;
+                continue;
+            }
+            ir::ContractivityOptions proof;
+            proof.max_work = per_proof;
+            const ir::ContractivityResult r = ir::prove_contractive(a, proof);
+            // A budget too small for a single product proves nothing: not a try.
+            if (!r.proven && r.work == 0) {
+                out_of_budget = true;
+                break;
+            }
+            ++tried;
+            contracts = r.proven;
+            proof_work_left -= r.work;
         }
         triangle_patches(b, a, index);
         volume_cells(b, a, index);
-        if (!contracts)
+        if (!contracts) {
+            if (out_of_budget)
+                fail(it.loc,
+                     fmt::format("the limit of {} steps of contraction proofs stopped the search for "
+                                 "values of the {} free entries of '{}' that make it contractive, "
+                                 "after {} of {} {}{}; fix some of them (frac solve shows them)",
+                                 limits_.max_bcifs_proof_work, sol->free.size(), it.name, tried, attempts,
+                                 seeded ? "draws" : "choices", raised_by("FRAC_MAX_BCIFS_PROOF_WORK")));
             fail(it.loc,
-                 seeded
-                     ? fmt::format("no values drawn from seed {} for the {} free entries of '{}' make it "
-                                   "contractive ({} draws); try another seed, or fix some of them (frac "
-                                   "solve shows them)",
-                                   *seed, sol->free.size(), it.name, attempts)
-                     : fmt::format("the compiler found no values of the {} free entries of '{}' that make "
-                                   "it contractive (the most uniform operators and {} nearby); fix some of "
-                                   "them (frac solve shows them)",
-                                   sol->free.size(), it.name, attempts - 1));
+                 seeded ? fmt::format("no values drawn from seed {} for the {} free entries of '{}' make it "
+                                      "contractive ({} draws); try another seed, or fix some of them (frac "
+                                      "solve shows them)",
+                                      *seed, sol->free.size(), it.name, attempts)
+                        : fmt::format("the compiler found no values of the {} free entries of '{}' that make "
+                                      "it contractive (the most uniform operators and {} nearby); fix some "
+                                      "of them (frac solve shows them)",
+                                      sol->free.size(), it.name, attempts - 1));
+        }
         info.solution = print_bcifs_solution(sys, *sol);
         std::vector<std::string> given;
         for (std::size_t p = 0; p < b.params.size(); ++p)

@@ -324,6 +324,7 @@ ContractivityResult prove_contractive(const Automaton& a, const ContractivityOpt
             (static_cast<double>(products) + total) * cube > options.max_work)
             break;
         products += static_cast<std::size_t>(total);
+        result.work = static_cast<double>(products) * cube;
         // M_L[a][b]: the largest bound over the paths a -> ... -> b of this length, in each of four
         // norm families (every state's direction coordinates with the 2-norm, the 1-norm or the max-norm,
         // or its full coordinates with the 1-norm): a family is one norm per state, so its products

@@ -57,6 +57,7 @@ struct ContractivityResult {
     std::vector<std::size_t> cycle;
     double cycle_rate = 0;
     std::string message; // the proof (bound, length) or the refusal naming the cycle
+    double work = 0;     // what it spent of ContractivityOptions::max_work
 };
 
 // Needs a structurally valid automaton whose arcs pass the size and affine checks (as check_automaton
