@@ -22,7 +22,7 @@ double scale_down(double x, int p, double dir) {
     return std::ldexp(y, p) == x ? y : std::nextafter(y, dir);
 }
 
-// The Euclidean norm of the vectors in the d <= 3 intervals v (under upward rounding). Components
+// The Euclidean norm of the vectors in the d intervals v (under upward rounding). Components
 // past 2^500 are scaled down by a power of two first, so that no square overflows (a point 1e160
 // away had the distance [1.3e154, inf]); the scaling is exact for every component that stays a
 // normal double, and the others are rounded outward.
@@ -259,11 +259,14 @@ DistanceResult AttractorDistance::query(const Interval* box) const {
     double best_max = num::inf; // upper bound of the maximum over the box of d(p, A)
 
     // The node's lower bound; updates the upper bounds with its witness.
+    std::vector<Interval> parts(3 * d); // its vectors to the ball's centre and witness, and outside the box
     auto evaluate = [&](const Node& node) {
         const StateBall& ball = balls_[node.state];
         const std::size_t n = states_[node.state].coords;
         const Interval* m = &pool[node.slot * stride];
-        Interval to_centre[3], to_witness[3], outside[3];
+        Interval* const to_centre = parts.data();
+        Interval* const to_witness = to_centre + d;
+        Interval* const outside = to_witness + d;
         for (std::size_t i = 0; i < d; ++i) {
             Interval ci(0.0), wi(0.0);
             for (std::size_t j = 0; j < n; ++j) {

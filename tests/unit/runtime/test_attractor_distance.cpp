@@ -274,6 +274,27 @@ TEST_CASE("far points: tight enclosures up to the largest double and beyond", "[
     CHECK(e.hi == num::inf);
 }
 
+TEST_CASE("distances in R4 through the library", "[distance]") {
+    // The language has spaces up to R3, the library any: the segment from 0 to (1, 0, 0, 0) as the
+    // attractor of x / 2 and x / 2 + (1/2, 0, 0, 0).
+    ir::Automaton segment;
+    segment.name = "segment";
+    segment.states.push_back({"s", ir::Space::euclidean(4), {}});
+    for (int k = 0; k < 2; ++k) {
+        num::Matrix<num::Rational> m(5, 5);
+        for (std::size_t i = 0; i < 4; ++i) m(i, i) = num::Rational(1, 2);
+        m(4, 4) = 1;
+        m(0, 4) = num::Rational(k, 2);
+        segment.arcs.push_back({0, 0, ir::Operator::from_exact(m), std::nullopt, ""});
+    }
+    const rt::AttractorDistance d(segment);
+    const double p[4] = {3, 0, 0, 4}; // nearest point (1, 0, 0, 0)
+    const num::Interval e = d.eval_point(p);
+    CHECK(e.lo <= std::sqrt(20.0));
+    CHECK(e.hi >= std::sqrt(20.0));
+    CHECK(e.hi - e.lo <= 2e-6);
+}
+
 TEST_CASE("distances in R3 and from several threads", "[distance]") {
     rt::DistanceOptions o;
     o.epsilon = 1e-8;
