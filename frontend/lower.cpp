@@ -1086,7 +1086,7 @@ private:
         const double per_proof = std::min(ir::ContractivityOptions{}.max_work, proof_work_left);
         int tried = 0;              // choices whose proof ran
         bool out_of_budget = false; // the limit stopped the search
-        for (int attempt = 0; attempt < attempts && !contracts && !out_of_budget; ++attempt) {
+        for (int attempt = 0; attempt < attempts && !contracts; ++attempt) {
             if (attempts > 1 && proof_work_left < per_proof) {
                 out_of_budget = true;
                 break;
